@@ -1,0 +1,28 @@
+# Two commands do all the set-up on a fresh machine:
+#   make solve   -> creates .venv from requirements.lock on first use, runs the main job
+#   make test    -> same venv, runs the test suite
+PY ?= python3
+VENV ?= .venv
+STAMP := $(VENV)/.installed
+
+.PHONY: solve test venv lint bench clean
+
+$(STAMP): pyproject.toml requirements.lock
+	$(PY) -m venv $(VENV)
+	$(VENV)/bin/pip install -q --upgrade pip
+	$(VENV)/bin/pip install -q -c requirements.lock -e '.[dev]'
+	touch $(STAMP)
+
+venv: $(STAMP)
+
+solve: $(STAMP)
+	$(VENV)/bin/ur3hanoi tables robots/stations/lab_sim.yaml --key sim_pos -o out/lab2_data.yaml
+
+test: $(STAMP)
+	$(VENV)/bin/python -m pytest -q
+
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
+
+clean:
+	rm -rf $(VENV) out

@@ -1,0 +1,8 @@
+"""ur3hanoi: kinematics toolkit for the UR3 Tower of Hanoi lab.
+
+Modules, one concept each: :mod:`~ur3hanoi.robot` (UR3 model, frames, limits), :mod:`~ur3hanoi.station`
+(calibration files), :mod:`~ur3hanoi.grid` (Cartesian tower grid), :mod:`~ur3hanoi.ik` (inverse kinematics),
+:mod:`~ur3hanoi.table` (``lab2_data.yaml``), :mod:`~ur3hanoi.cli` (the ``ur3hanoi`` command).
+"""
+
+__version__ = "0.1.0"

@@ -1,0 +1,309 @@
+"""Inverse kinematics of the UR3: closed-form branches, and two numerical solvers behind one interface.
+
+- :func:`analytic_ik` enumerates the (up to) 8 closed-form solutions of a flange pose from the DH geometry; it
+  names each by its configuration branch (shoulder, elbow, wrist signs).
+- :class:`PinocchioIK` (damped least squares on the SE(3) log error) and :class:`PlacoIK` (placo's
+  ``KinematicsSolver`` with a frame task) refine a seed to machine precision. Both solve for the ``tcp`` frame
+  in the controller ``base`` frame and return an :class:`IKResult` whose errors are measured by FK.
+- :func:`solve_on_branch` is what tables use: solve from a seed, then require the home branch and the
+  2pi-equivalent of every joint nearest to home within limits, so moves between waypoints never flip the arm.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+
+from ur3hanoi.errors import IKError, Ur3HanoiError
+from ur3hanoi.robot import DH_A, DH_ALPHA, DH_D, N_JOINTS, T_BASELINK_BASE, JointLimits, Ur3Model, dh_fk
+
+FloatArray = npt.NDArray[np.float64]
+Branch = tuple[int, int, int]
+
+POSITION_TOL = 1e-9  # [m] required accuracy of every table pose
+ORIENTATION_TOL = 1e-9  # [rad]
+SOLVERS: tuple[str, ...] = ("pinocchio", "placo")
+
+
+def wrap_angle(x: FloatArray | float) -> FloatArray:
+    """Angles wrapped to [-pi, pi)."""
+    return (np.asarray(x, dtype=float) + math.pi) % (2 * math.pi) - math.pi
+
+
+def pose_errors(T_actual: pin.SE3, T_target: pin.SE3) -> tuple[float, float]:
+    """(position error [m], orientation error [rad]) between two poses."""
+    dp = float(np.linalg.norm(T_actual.translation - T_target.translation))
+    dR = T_actual.rotation.T @ T_target.rotation
+    return dp, float(np.linalg.norm(pin.log3(dR)))
+
+
+# ------------------------------------------------------------------------------------------------ branches
+
+
+def _p05(q: FloatArray) -> FloatArray:
+    """Origin of DH frame 5 (the wrist point used for the shoulder branch) in base [m]."""
+    T06 = dh_fk(q)
+    return T06[:3, 3] - DH_D[5] * T06[:3, 2]
+
+
+def branch_of(q: FloatArray) -> Branch:
+    """Configuration branch of ``q`` [rad] as signs (shoulder, elbow, wrist), each +1 or -1.
+
+    shoulder: which of the two base angles that put the wrist point in the arm plane ("left/right");
+    elbow: sign of sin(q3) ("up/down"); wrist: sign of sin(q5) ("flip").
+    """
+    q = np.asarray(q, dtype=float)
+    p = _p05(q)
+    psi = math.atan2(p[1], p[0])
+    shoulder = 1 if float(wrap_angle(q[0] - psi - math.pi / 2)) >= 0.0 else -1
+    elbow = 1 if math.sin(q[2]) >= 0.0 else -1
+    wrist = 1 if math.sin(q[4]) >= 0.0 else -1
+    return (shoulder, elbow, wrist)
+
+
+BRANCHES: tuple[Branch, ...] = tuple((s, e, w) for s in (1, -1) for e in (1, -1) for w in (1, -1))
+
+
+def analytic_ik(T_base_tool0: FloatArray | pin.SE3) -> dict[Branch, FloatArray]:
+    """Closed-form UR IK of a flange (``tool0``) pose in ``base``: ``{branch: q}`` for every reachable branch.
+
+    Angles are in [-pi, pi). Singular wrist configurations (sin q5 ~ 0) are skipped.
+    """
+    T = T_base_tool0.homogeneous if isinstance(T_base_tool0, pin.SE3) else np.asarray(T_base_tool0, dtype=float)
+    d4, d6 = DH_D[3], DH_D[5]
+    a2, a3 = DH_A[1], DH_A[2]
+    R, p = T[:3, :3], T[:3, 3]
+    p05 = p - d6 * R[:, 2]
+    r = math.hypot(p05[0], p05[1])
+    out: dict[Branch, FloatArray] = {}
+    if r < abs(d4):
+        return out
+    psi, phi = math.atan2(p05[1], p05[0]), math.acos(d4 / r)
+    for s1 in (1, -1):
+        q1 = psi + s1 * phi + math.pi / 2
+        c1, sn1 = math.cos(q1), math.sin(q1)
+        z1 = np.array([sn1, -c1, 0.0])  # joint 2..4 axis in base
+        c5 = (float(p @ z1) - d4) / d6
+        if abs(c5) > 1.0:
+            continue
+        for s5 in (1, -1):
+            q5 = s5 * math.acos(c5)
+            sin5 = math.sin(q5)
+            if abs(sin5) < 1e-10:
+                continue
+            q6 = math.atan2(-float(R[:, 1] @ z1) / sin5, float(R[:, 0] @ z1) / sin5)
+            # Planar 3R problem (joints 2-4) in DH frame 1.
+            T14 = _inv_h(_dh(q1, 0)) @ T @ _inv_h(_dh(q5, 4) @ _dh(q6, 5))
+            px, py = T14[0, 3], T14[1, 3]
+            c3 = (px * px + py * py - a2 * a2 - a3 * a3) / (2 * a2 * a3)
+            if abs(c3) > 1.0:
+                continue
+            for s3 in (1, -1):
+                q3 = s3 * math.acos(c3)
+                q2 = math.atan2(py, px) - math.atan2(a3 * math.sin(q3), a2 + a3 * math.cos(q3))
+                q4 = math.atan2(T14[1, 0], T14[0, 0]) - q2 - q3
+                # By construction the branch is (s1, s3, s5): see branch_of.
+                out[(s1, s3, s5)] = wrap_angle(np.array([q1, q2, q3, q4, q5, q6]))
+    return out
+
+
+def _dh(theta: float, i: int) -> FloatArray:
+    ct, st = math.cos(theta), math.sin(theta)
+    ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
+    return np.array(
+        [[ct, -st * ca, st * sa, DH_A[i] * ct], [st, ct * ca, -ct * sa, DH_A[i] * st], [0, sa, ca, DH_D[i]],
+         [0, 0, 0, 1.0]]
+    )
+
+
+def _inv_h(T: FloatArray) -> FloatArray:
+    R, p = T[:3, :3], T[:3, 3]
+    out = np.eye(4)
+    out[:3, :3] = R.T
+    out[:3, 3] = -R.T @ p
+    return out
+
+
+def nearest_equivalent(q: FloatArray, q_ref: FloatArray, limits: JointLimits) -> FloatArray | None:
+    """Each joint of ``q`` shifted by a multiple of 2pi to be nearest ``q_ref`` within limits (None if none fits)."""
+    q = np.asarray(q, dtype=float)
+    q_ref = np.asarray(q_ref, dtype=float)
+    out = q_ref + wrap_angle(q - q_ref)
+    lo, hi = np.asarray(limits.q_min), np.asarray(limits.q_max)
+    for i in range(N_JOINTS):
+        if out[i] > hi[i] + 1e-12:
+            out[i] -= 2 * math.pi
+        elif out[i] < lo[i] - 1e-12:
+            out[i] += 2 * math.pi
+        if not lo[i] - 1e-12 <= out[i] <= hi[i] + 1e-12:
+            return None
+    return out
+
+
+# ------------------------------------------------------------------------------------------------- solvers
+
+
+@dataclass(frozen=True)
+class IKResult:
+    """Outcome of one IK solve. ``q`` [rad]; errors measured by Pinocchio FK of the ``tcp`` frame."""
+
+    q: FloatArray
+    position_error: float  # [m]
+    orientation_error: float  # [rad]
+    iterations: int
+    solver: str
+
+    @property
+    def converged(self) -> bool:
+        return self.position_error <= POSITION_TOL and self.orientation_error <= ORIENTATION_TOL
+
+
+class IKSolver(Protocol):
+    """Numerical IK of the ``tcp`` frame; targets are ``T_base_tcp`` poses in the controller ``base`` frame."""
+
+    name: str
+    robot: Ur3Model
+
+    def solve(self, T_base_tcp: pin.SE3, q_seed: FloatArray) -> IKResult: ...
+
+
+class PinocchioIK:
+    """Damped least squares on the SE(3) log error (full Newton steps with ``Jlog6``).
+
+    Args:
+        robot: model with the station's ``tcp`` frame.
+        max_iterations: iteration cap (converged solves take 3-6).
+        damping: Tikhonov damping of J J^T [-]; tiny so the last steps stay quadratic.
+        stop_tol: stop once the log error norm is below this (well under the 1e-9 acceptance).
+    """
+
+    name = "pinocchio"
+
+    def __init__(self, robot: Ur3Model, max_iterations: int = 100, damping: float = 1e-12,
+                 stop_tol: float = 1e-13) -> None:
+        self.robot = robot
+        self.max_iterations = max_iterations
+        self.damping = damping
+        self.stop_tol = stop_tol
+        self._fid = robot.frame_ids["tcp"]
+
+    def solve(self, T_base_tcp: pin.SE3, q_seed: FloatArray) -> IKResult:
+        model, data = self.robot.model, self.robot.data
+        # Work in the URDF root frame (base_link) where Pinocchio's oMf lives.
+        target = T_BASELINK_BASE * T_base_tcp
+        q = np.array(q_seed, dtype=float)
+        it = 0
+        for it in range(1, self.max_iterations + 1):
+            pin.framesForwardKinematics(model, data, q)
+            iMd = data.oMf[self._fid].actInv(target)
+            err = pin.log6(iMd).vector
+            if float(np.linalg.norm(err)) < self.stop_tol:
+                break
+            J = pin.computeFrameJacobian(model, data, q, self._fid, pin.LOCAL)
+            J = -pin.Jlog6(iMd.inverse()) @ J
+            dq = -J.T @ np.linalg.solve(J @ J.T + self.damping * np.eye(6), err)
+            # Cap the step: far from the solution a full Gauss-Newton step can leap across branches.
+            step = float(np.max(np.abs(dq)))
+            if step > 0.5:
+                dq *= 0.5 / step
+            q = q + dq
+        dp, dr = pose_errors(self.robot.fk(q, "tcp"), T_base_tcp)
+        return IKResult(q=q, position_error=dp, orientation_error=dr, iterations=it, solver=self.name)
+
+
+class PlacoIK:
+    """placo ``KinematicsSolver`` with one hard-ish frame task on ``tcp`` (floating base masked).
+
+    placo cannot resolve ``package://`` URIs, so it is given the URDF text with absolute mesh paths.
+    """
+
+    name = "placo"
+
+    def __init__(self, robot: Ur3Model, max_iterations: int = 50, stop_tol: float = 1e-13) -> None:
+        import placo  # imported here: placo is heavy and only this solver needs it
+
+        self.robot = robot
+        self.max_iterations = max_iterations
+        self.stop_tol = stop_tol
+        self._robot = placo.RobotWrapper("", placo.Flags.ignore_collisions, robot.urdf)
+        self._solver = placo.KinematicsSolver(self._robot)
+        self._solver.mask_fbase(True)
+        self._solver.enable_joint_limits(False)  # limits are enforced by solve_on_branch, on the 2pi-shift
+        self._solver.enable_velocity_limits(False)
+        self._task = self._solver.add_frame_task("tcp", np.eye(4))
+        self._task.configure("tcp", "soft", 1.0, 1.0)
+        self._names = list(self.robot.model.names[1:])
+
+    def solve(self, T_base_tcp: pin.SE3, q_seed: FloatArray) -> IKResult:
+        target = (T_BASELINK_BASE * T_base_tcp).homogeneous
+        self._task.T_world_frame = target
+        for name, v in zip(self._names, np.asarray(q_seed, dtype=float), strict=True):
+            self._robot.set_joint(name, float(v))
+        self._robot.update_kinematics()
+        it = 0
+        for it in range(1, self.max_iterations + 1):
+            self._solver.solve(True)
+            self._robot.update_kinematics()
+            T = self._robot.get_T_world_frame("tcp")
+            if np.linalg.norm(pin.log6(pin.SE3(T).actInv(pin.SE3(target))).vector) < self.stop_tol:
+                break
+        q = np.array([self._robot.get_joint(n) for n in self._names])
+        dp, dr = pose_errors(self.robot.fk(q, "tcp"), T_base_tcp)
+        return IKResult(q=q, position_error=dp, orientation_error=dr, iterations=it, solver=self.name)
+
+
+def make_solver(name: str, robot: Ur3Model) -> IKSolver:
+    """The solver called ``name`` (one of :data:`SOLVERS`) for ``robot``."""
+    if name == "pinocchio":
+        return PinocchioIK(robot)
+    if name == "placo":
+        return PlacoIK(robot)
+    raise Ur3HanoiError(f"IK solver {name!r} is unknown: expected one of {SOLVERS}")
+
+
+def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3, q_home: FloatArray, label: str = "pose") -> IKResult:
+    """Solve ``T_base_tcp`` on the branch of ``q_home``, each joint the 2pi-equivalent nearest home.
+
+    The seed is the closed-form solution on home's branch (so the numerical solver cannot wander to another
+    branch); the numerical solver then refines it to <= 1e-9 m / 1e-9 rad, checked by FK.
+
+    Raises:
+        IKError: unreachable pose, no solution on the home branch, out of limits, or not converged; the message
+            names ``label``, the target pose and the residual.
+    """
+    robot = solver.robot
+    q_home = np.asarray(q_home, dtype=float)
+    home_branch = branch_of(q_home)
+    T_base_tool0 = T_base_tcp * robot.T_flange_tcp("tool0").inverse()
+    xyz = np.round(T_base_tcp.translation, 4).tolist()
+    rpy = np.round(np.degrees(pin.rpy.matrixToRpy(T_base_tcp.rotation)), 2).tolist()
+    where = f"{label}: target xyz {xyz} m rpy {rpy} deg in base"
+    branches = analytic_ik(T_base_tool0)
+    if not branches:
+        raise IKError(f"{where} is unreachable by the UR3 (no closed-form solution; residual n/a)")
+    if home_branch not in branches:
+        raise IKError(f"{where} has no solution on home's branch {home_branch} (reachable: {sorted(branches)})")
+    seed = nearest_equivalent(branches[home_branch], q_home, _no_limits())
+    assert seed is not None
+    res = solver.solve(T_base_tcp, seed)
+    q = nearest_equivalent(res.q, q_home, robot.limits)
+    if q is None:
+        raise IKError(f"{where}: solution {np.round(np.degrees(res.q), 3).tolist()} deg is outside the joint limits")
+    res = IKResult(q=q, position_error=res.position_error, orientation_error=res.orientation_error,
+                   iterations=res.iterations, solver=res.solver)
+    if not res.converged or branch_of(q) != home_branch:
+        raise IKError(
+            f"{where}: {solver.name} did not converge on home's branch {home_branch} "
+            f"(residual {res.position_error:.3e} m, {res.orientation_error:.3e} rad, branch {branch_of(q)})"
+        )
+    return res
+
+
+def _no_limits() -> JointLimits:
+    big = (1e9,) * N_JOINTS
+    return JointLimits(q_min=tuple(-b for b in big), q_max=big, v_max=big, a_max=big, j_max=big)

@@ -1,0 +1,286 @@
+"""The UR3 (CB3) model: URDF location, DH parameters, datasheet limits, and Pinocchio forward kinematics.
+
+Frames (all right-handed, metres):
+
+- ``base``: the UR controller's base frame, the frame of the DH convention. **Every joint value and every
+  ``T_base_*`` pose in ur3hanoi is in this frame**, like the lab's tables and the teach pendant.
+- ``base_link``: the URDF root. It is ``base`` rotated by pi about z (``T_baselink_base = Rz(pi)``).
+- ``tool0``: the flange, z along the tool axis (the DH end frame).
+- ``ee_link``: the flange with x along the tool axis (the course's suction offset is given from it).
+- ``tcp``: the suction point, added to the model from a :class:`ToolOffset`.
+
+Joint values follow the controller convention: the URDF's joint zeros equal the DH zeros, so the same ``q`` [rad]
+drives both; only the root frame differs.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import math
+import re
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+
+from ur3hanoi.errors import Ur3HanoiError
+
+FloatArray = npt.NDArray[np.float64]
+
+JOINT_NAMES: tuple[str, ...] = (
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+)
+N_JOINTS = 6
+
+# UR3 (CB3) DH parameters [m, rad], from Universal Robots' published DH table.
+DH_D: tuple[float, ...] = (0.1519, 0.0, 0.0, 0.11235, 0.08535, 0.0819)
+DH_A: tuple[float, ...] = (0.0, -0.24365, -0.21325, 0.0, 0.0, 0.0)
+DH_ALPHA: tuple[float, ...] = (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0)
+
+# Controller `base` seen from URDF `base_link`: a half turn about z.
+T_BASELINK_BASE = pin.SE3(pin.utils.rotate("z", math.pi), np.zeros(3))
+
+# The lab's home: radians([120, -90, 90, -90, -90, 0]).
+Q_HOME_LAB: tuple[float, ...] = tuple(math.radians(d) for d in (120.0, -90.0, 90.0, -90.0, -90.0, 0.0))
+
+
+@dataclass(frozen=True)
+class JointLimits:
+    """UR3 joint limits, from the CB3 datasheet unless stated.
+
+    The URDF of example-robot-data carries UR5-like velocity/effort values: they are deliberately not used.
+
+    Attributes:
+        q_min, q_max: position limits [rad]; datasheet +-2pi on every joint. ROS configs often restrict the elbow
+            to +-pi: pass ``elbow_limit=math.pi`` to :meth:`ur3`.
+        v_max: speed limits [rad/s]; datasheet 180 deg/s for base/shoulder/elbow, 360 deg/s for the wrists.
+        a_max: acceleration limits [rad/s^2]. Not published by UR; default 4 rad/s^2 (joints 1-3) and 8 rad/s^2
+            (wrists) keeps the UR3's 56/28/12 N m torques with margin at the lab's 0.0225 kg payload.
+        j_max: jerk limits [rad/s^3]. Not published; default 20 rad/s^3 (joints 1-3), 40 rad/s^3 (wrists).
+    """
+
+    q_min: tuple[float, ...]
+    q_max: tuple[float, ...]
+    v_max: tuple[float, ...]
+    a_max: tuple[float, ...]
+    j_max: tuple[float, ...]
+
+    @classmethod
+    def ur3(cls, elbow_limit: float = 2 * math.pi) -> JointLimits:
+        """Datasheet limits; ``elbow_limit`` [rad] optionally restricts the elbow (ROS configs use pi)."""
+        if not 0.0 < elbow_limit <= 2 * math.pi:
+            raise Ur3HanoiError(f"elbow_limit = {elbow_limit!r} rad is invalid: expected 0 < elbow_limit <= 2*pi")
+        two_pi = 2 * math.pi
+        q_max = (two_pi, two_pi, elbow_limit, two_pi, two_pi, two_pi)
+        return cls(
+            q_min=tuple(-x for x in q_max),
+            q_max=q_max,
+            v_max=(math.pi,) * 3 + (two_pi,) * 3,
+            a_max=(4.0,) * 3 + (8.0,) * 3,
+            j_max=(20.0,) * 3 + (40.0,) * 3,
+        )
+
+    def within_position(self, q: FloatArray, tol: float = 1e-12) -> bool:
+        """True when every joint of ``q`` [rad] is inside [q_min, q_max] (with ``tol`` [rad] slack)."""
+        q = np.asarray(q, dtype=float)
+        return bool(np.all(q >= np.asarray(self.q_min) - tol) and np.all(q <= np.asarray(self.q_max) + tol))
+
+
+@dataclass(frozen=True)
+class ToolOffset:
+    """The suction point (TCP) as a fixed offset from a flange frame.
+
+    Attributes:
+        parent: ``"ee_link"`` (x along the tool axis, the course URDF's convention) or ``"tool0"`` (z along it).
+        xyz: translation [m] in the parent frame.
+        rpy: URDF roll-pitch-yaw [rad] (fixed axes x, y, z) of the TCP frame in the parent frame.
+    """
+
+    parent: str = "ee_link"
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def T_parent_tcp(self) -> pin.SE3:
+        """The TCP pose in its parent flange frame."""
+        return pin.SE3(pin.rpy.rpyToMatrix(*self.rpy), np.array(self.xyz, dtype=float))
+
+
+FLANGE_FRAMES: tuple[str, ...] = ("ee_link", "tool0")
+
+
+def _erd_share_dir() -> Path:
+    """`cmeel.prefix/share` of the installed example-robot-data, found without importing its loaders."""
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError as exc:
+        raise Ur3HanoiError(
+            "example-robot-data is not installed: run `make venv` (it installs requirements.lock)"
+        ) from exc
+    return Path(str(dist.locate_file("cmeel.prefix/share")))
+
+
+def urdf_path() -> Path:
+    """Path of example-robot-data's ``ur3_robot.urdf`` (loaded by path: some loaders map "ur3" to a UR5)."""
+    path = _erd_share_dir() / "example-robot-data/robots/ur_description/urdf/ur3_robot.urdf"
+    if not path.is_file():
+        raise Ur3HanoiError(f"UR3 URDF not found at {path}: example-robot-data >= 4.4 is required")
+    return path
+
+
+def package_dir() -> Path:
+    """Directory that resolves the URDF's ``package://example-robot-data/...`` mesh URIs."""
+    return _erd_share_dir()
+
+
+def _fmt(x: float) -> str:
+    return repr(float(x))
+
+
+@cache
+def urdf_text(tool: ToolOffset | None = None, absolute_meshes: bool = True) -> str:
+    """The UR3 URDF as text, optionally with a ``tcp`` link fixed to ``tool.parent``.
+
+    ``absolute_meshes`` rewrites ``package://`` URIs to absolute paths (placo and MuJoCo cannot resolve them).
+    """
+    text = urdf_path().read_text()
+    if absolute_meshes:
+        text = text.replace("package://", str(package_dir()) + "/")
+    if tool is not None:
+        if tool.parent not in FLANGE_FRAMES:
+            raise Ur3HanoiError(f"tool parent frame {tool.parent!r} is invalid: expected one of {FLANGE_FRAMES}")
+        xyz = " ".join(_fmt(v) for v in tool.xyz)
+        rpy = " ".join(_fmt(v) for v in tool.rpy)
+        tcp = (
+            '  <link name="tcp"/>\n'
+            '  <joint name="tcp_fixed_joint" type="fixed">\n'
+            f'    <parent link="{tool.parent}"/>\n    <child link="tcp"/>\n'
+            f'    <origin xyz="{xyz}" rpy="{rpy}"/>\n  </joint>\n'
+        )
+        text = re.sub(r"</robot>\s*$", tcp + "</robot>\n", text)
+    return text
+
+
+def dh_fk(q: FloatArray) -> FloatArray:
+    """UR3 forward kinematics from the DH table: the 4x4 pose of the flange (``tool0``) in ``base``."""
+    T = np.eye(4)
+    for qi, d, a, alpha in zip(np.asarray(q, dtype=float), DH_D, DH_A, DH_ALPHA, strict=True):
+        ct, st, ca, sa = math.cos(qi), math.sin(qi), math.cos(alpha), math.sin(alpha)
+        T = T @ np.array(
+            [
+                [ct, -st * ca, st * sa, a * ct],
+                [st, ct * ca, -ct * sa, a * st],
+                [0.0, sa, ca, d],
+                [0.0, 0.0, 0.0, 1.0],
+            ]
+        )
+    return T
+
+
+# Link lengths the URDF must encode [m]; a UR5 (d1 = 0.089159, a2 = 0.425) fails this check.
+_EXPECTED_LENGTHS = {"d1": 0.1519, "a2": 0.24365, "a3": 0.21325, "d4": 0.11235, "d5": 0.08535, "d6": 0.0819}
+
+
+def _link_lengths(model: pin.Model) -> dict[str, float]:
+    def p(name: str) -> FloatArray:
+        return model.jointPlacements[model.getJointId(name)].translation
+
+    fid = model.getFrameId("tool0")
+    return {
+        "d1": float(p("shoulder_pan_joint")[2]),
+        "a2": float(p("elbow_joint")[2]),
+        "a3": float(p("wrist_1_joint")[2]),
+        "d4": float(p("shoulder_lift_joint")[1] + p("elbow_joint")[1] + p("wrist_2_joint")[1]),
+        "d5": float(p("wrist_3_joint")[2]),
+        "d6": float(model.frames[fid].placement.translation[1]),
+    }
+
+
+class Ur3Model:
+    """Pinocchio model of the UR3 with an optional ``tcp`` frame.
+
+    FK results are expressed in the controller ``base`` frame (see the module docstring).
+
+    Args:
+        tool: the suction point offset; without it the ``tcp`` frame equals ``tool0``.
+        limits: joint limits to report and enforce (datasheet values by default).
+    """
+
+    def __init__(self, tool: ToolOffset | None = None, limits: JointLimits | None = None) -> None:
+        self.tool = tool if tool is not None else ToolOffset(parent="tool0")
+        self.limits = limits if limits is not None else JointLimits.ur3()
+        self.urdf = urdf_text(self.tool, absolute_meshes=True)
+        self.model: pin.Model = pin.buildModelFromXML(self.urdf)
+        self.data: pin.Data = self.model.createData()
+        if tuple(self.model.names[1:]) != JOINT_NAMES:
+            raise Ur3HanoiError(f"URDF joints {tuple(self.model.names[1:])} are not the UR3's {JOINT_NAMES}")
+        lengths = _link_lengths(self.model)
+        for key, expected in _EXPECTED_LENGTHS.items():
+            if abs(lengths[key] - expected) > 1e-6:
+                raise Ur3HanoiError(
+                    f"{urdf_path()}: link length {key} = {lengths[key]} m, expected the UR3's {expected} m "
+                    "(is this a UR5/UR10 URDF?)"
+                )
+        self.frame_ids = {name: self.model.getFrameId(name) for name in ("base", "base_link", "tool0", "tcp")}
+        self.frame_ids["ee_link"] = self.model.getFrameId("ee_link")
+        self._T_base_baselink = T_BASELINK_BASE.inverse()
+
+    @property
+    def nq(self) -> int:
+        return int(self.model.nq)
+
+    def fk(self, q: FloatArray, frame: str = "tcp") -> pin.SE3:
+        """Pose of ``frame`` in the controller ``base`` frame at joint angles ``q`` [rad]."""
+        try:
+            fid = self.frame_ids[frame]
+        except KeyError:
+            raise Ur3HanoiError(f"frame {frame!r} is unknown: expected one of {sorted(self.frame_ids)}") from None
+        pin.framesForwardKinematics(self.model, self.data, np.asarray(q, dtype=float))
+        return self._T_base_baselink * self.data.oMf[fid]
+
+    def frame_jacobian_local(self, q: FloatArray, frame: str = "tcp") -> FloatArray:
+        """6x6 Jacobian of ``frame`` in its own (LOCAL) frame; frame-independent of the root rotation."""
+        return pin.computeFrameJacobian(
+            self.model, self.data, np.asarray(q, dtype=float), self.frame_ids[frame], pin.LOCAL
+        )
+
+    def T_flange_tcp(self, flange: str = "tool0") -> pin.SE3:
+        """The constant TCP pose in a flange frame (``tool0`` or ``ee_link``)."""
+        f = self.model.frames
+        return f[self.frame_ids[flange]].placement.actInv(f[self.frame_ids["tcp"]].placement)
+
+
+@cache
+def load_ur3(tool: ToolOffset | None = None, limits: JointLimits | None = None) -> Ur3Model:
+    """Cached :class:`Ur3Model` for a tool offset (models are read-only after construction).
+
+    Not thread-safe: each model owns one ``pin.Data`` used by :meth:`Ur3Model.fk`.
+    """
+    return Ur3Model(tool, limits)
+
+
+__all__ = [
+    "DH_A",
+    "DH_ALPHA",
+    "DH_D",
+    "FLANGE_FRAMES",
+    "JOINT_NAMES",
+    "N_JOINTS",
+    "Q_HOME_LAB",
+    "T_BASELINK_BASE",
+    "JointLimits",
+    "ToolOffset",
+    "Ur3Model",
+    "dh_fk",
+    "load_ur3",
+    "package_dir",
+    "urdf_path",
+    "urdf_text",
+]
