@@ -48,7 +48,7 @@ class SimulationError(Ur3HanoiError):
     """The MuJoCo scene could not be built or run."""
 
 
-class SuctionFault(Ur3HanoiError):
+class SuctionFaultError(Ur3HanoiError):
     """Suction feedback says no block is held where one should be (the lab's halt condition)."""
 
     exit_code = 3
