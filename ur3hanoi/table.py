@@ -26,7 +26,7 @@ import yaml
 from ur3hanoi import __version__
 from ur3hanoi.errors import IKError, TableError
 from ur3hanoi.grid import POSE_NAMES, T_base_tcp, T_world_tcp, block_xy_pos
-from ur3hanoi.ik import IKResult, IKSolver, make_solver, pose_errors, solve_on_branch
+from ur3hanoi.ik import IKResult, IKSolver, branch_of, make_solver, pose_errors, solve_on_branch
 from ur3hanoi.robot import N_JOINTS, load_ur3
 from ur3hanoi.station import Station
 
@@ -67,11 +67,12 @@ def generate_table(station: Station, solver: str | IKSolver = "pinocchio") -> Ta
         solver = make_solver(solver, load_ur3(station.tool, station.limits))
     q = np.empty((station.n_towers, station.n_heights, 2, N_JOINTS))
     results = []
+    home_branch = branch_of(station.q_home_array)
     for t in range(station.n_towers):
         for h in range(station.n_heights):
             for k in (0, 1):
                 res = solve_on_branch(solver, T_base_tcp(station, t, h, k), station.q_home_array,
-                                      label=f"{station.source}: {pose_label(t, h, k)}")
+                                      label=f"{station.source}: {pose_label(t, h, k)}", home_branch=home_branch)
                 q[t, h, k] = res.q
                 results.append(res)
     return Table(station=station, q=q, results=tuple(results), solver=solver.name)

@@ -1,0 +1,74 @@
+"""Benchmark (not a test): IK microseconds per pose for each solver, and `ur3hanoi tables` wall time.
+
+Run: .venv/bin/python bench/bench_ik.py   (targets: 18-pose table < 5 ms of IK compute; `tables` < 1 s)
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ur3hanoi.grid import T_base_tcp
+from ur3hanoi.ik import SOLVERS, branch_of, make_solver, solve_on_branch
+from ur3hanoi.robot import load_ur3
+from ur3hanoi.station import load_station
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def bench_solver(name: str, station_path: Path, repeats: int = 200) -> dict[str, float]:
+    station = load_station(station_path)
+    robot = load_ur3(station.tool, station.limits)
+    solver = make_solver(name, robot)
+    targets = [T_base_tcp(station, t, h, k) for t in range(station.n_towers) for h in range(station.n_heights)
+               for k in (0, 1)]
+    q_home = station.q_home_array
+    home = branch_of(q_home)
+    for T in targets:  # warm-up
+        solve_on_branch(solver, T, q_home, home_branch=home)
+    per_table = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for T in targets:
+            solve_on_branch(solver, T, q_home, home_branch=home)
+        per_table.append(time.perf_counter() - t0)
+    med = float(np.median(per_table))
+    return {"us_per_pose": med / len(targets) * 1e6, "ms_per_table": med * 1e3, "poses": len(targets)}
+
+
+def bench_cli(repeats: int = 5) -> float:
+    walls = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            subprocess.run([sys.executable, "-m", "ur3hanoi.cli", "tables", "robots/stations/lab_sim.yaml",
+                            "--key", "sim_pos", "-o", f"{tmp}/lab2_data.yaml"], cwd=REPO, check=True,
+                           capture_output=True)
+            walls.append(time.perf_counter() - t0)
+    return float(np.median(walls))
+
+
+def main() -> dict[str, object]:
+    results: dict[str, object] = {}
+    for station in ("lab_sim", "lab_real"):
+        for name in SOLVERS:
+            r = bench_solver(name, REPO / f"robots/stations/{station}.yaml")
+            results[f"ik_{name}_{station}"] = r
+            print(f"IK {name:9s} {station:8s}: {r['us_per_pose']:7.1f} us/pose, {r['ms_per_table']:.2f} ms per "
+                  f"{r['poses']}-pose table (target < 5 ms)")
+    wall = bench_cli()
+    results["tables_cli_wall_s"] = wall
+    print(f"`ur3hanoi tables` end to end (lab_sim): {wall:.3f} s wall (target < 1 s)")
+    return results
+
+
+if __name__ == "__main__":
+    out = main()
+    if "--json" in sys.argv:
+        print(json.dumps(out))
