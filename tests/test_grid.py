@@ -58,7 +58,7 @@ def test_stacked_heights_are_vertical(lab_real: Station) -> None:
 @pytest.mark.parametrize("yaw", [0.0, 0.7, math.pi / 2, -2.5])
 def test_down_rotation_is_proper_and_heads_along_yaw(yaw: float) -> None:
     R = R_world_tcp_down(yaw)
-    assert R.T @ R == pytest.approx(np.eye(3), abs=1e-12)
+    assert pytest.approx(np.eye(3), abs=1e-12) == R.T @ R
     assert np.linalg.det(R) == pytest.approx(1.0)
     assert R[:, 0] == pytest.approx([math.cos(yaw), math.sin(yaw), 0.0], abs=1e-12)
     assert R[:, 2] == pytest.approx([0, 0, -1.0], abs=1e-12)

@@ -110,24 +110,24 @@ def test_bad_field_names_file_field_value_and_range(field: str, value: Any, matc
 
 
 def test_stacked_height_step_must_be_one_block() -> None:
-    with pytest.raises(CalibrationError, match="grid.height_step.*stacked"):
+    with pytest.raises(CalibrationError, match=r"grid\.height_step.*stacked"):
         parse_station(_mutated(LAB_REAL, "grid.height_step", [0.0, 0.0, 0.05]), "bad.yaml")
 
 
 def test_tower_origins_count_must_match() -> None:
-    with pytest.raises(CalibrationError, match="grid.tower_origins"):
+    with pytest.raises(CalibrationError, match=r"grid\.tower_origins"):
         parse_station(_mutated(LAB_REAL, "grid.towers", 4), "bad.yaml")
 
 
 def test_both_tower_forms_is_an_error() -> None:
     raw = _mutated(LAB_REAL, "grid.origin", [0.3, 0.0, 0.03])
-    with pytest.raises(CalibrationError, match="grid.origin"):
+    with pytest.raises(CalibrationError, match=r"grid\.origin"):
         parse_station(raw, "bad.yaml")
 
 
 def test_degrees_and_radians_both_given_is_an_error() -> None:
     raw = _mutated(LAB_SIM, "robot.home_rad", [0.0] * 6)
-    with pytest.raises(CalibrationError, match="robot.home_rad"):
+    with pytest.raises(CalibrationError, match=r"robot\.home_rad"):
         parse_station(raw, "bad.yaml")
 
 
