@@ -1,13 +1,15 @@
 # Two commands do all the set-up on a fresh machine:
-#   make solve   -> creates .venv from requirements.lock on first use, runs the main job
-#   make test    -> same venv, runs the test suite
+#   make solve   -> creates .venv from requirements.lock on first use, runs the main job (headless MuJoCo solve)
+#   make test    -> same venv, runs the test suite (notebooks included)
 PY ?= python3
 VENV ?= .venv
 STAMP := $(VENV)/.installed
+export MUJOCO_GL ?= egl
 
 .PHONY: solve test venv lint bench tables clean
 
 $(STAMP): pyproject.toml requirements.lock
+	bash tools/ensure-system-deps.sh
 	$(PY) -m venv $(VENV)
 	$(VENV)/bin/pip install -q --upgrade pip
 	$(VENV)/bin/pip install -q -c requirements.lock -e '.[dev]'
@@ -16,7 +18,7 @@ $(STAMP): pyproject.toml requirements.lock
 venv: $(STAMP)
 
 solve: $(STAMP)
-	$(VENV)/bin/ur3hanoi tables robots/stations/lab_sim.yaml --key sim_pos -o out/lab2_data.yaml
+	$(VENV)/bin/ur3hanoi solve --start 1 --end 3
 
 test: $(STAMP)
 	$(VENV)/bin/python -m pytest -q
@@ -29,5 +31,8 @@ tables: $(STAMP)
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
 
+bench: $(STAMP)
+	$(VENV)/bin/python bench/run_all.py
+
 clean:
-	rm -rf $(VENV) out
+	rm -rf $(VENV)
