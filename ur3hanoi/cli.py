@@ -90,9 +90,65 @@ def _run_check_table(args: argparse.Namespace) -> int:
     return 1 if bad else 0
 
 
+# -------------------------------------------------------------------------------------------------- calibrate
+
+
+def _add_calibrate(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("calibrate", help="fit a station's tower grid to taught poses (least squares)",
+                       description="Fit the tower origins, height step, approach and tool yaw of a station to "
+                                   "taught joint poses (or to every entry of an existing lab-format table); "
+                                   "everything else comes from --base. Prints the residual of every point [mm] "
+                                   "and warns about points over 2 mm. See `ur3hanoi.calibrate` for the format.")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--taught", metavar="FILE", help="taught-points YAML (units: deg|rad; points: [...])")
+    src.add_argument("--from-table", metavar="FILE", help="lab-format table whose entries are the taught points")
+    p.add_argument("--key", help="table key with --from-table (sim_pos or real_pos)")
+    p.add_argument("--base", required=True, metavar="CALIBRATION",
+                   help="station calibration providing robot base, tool, blocks, home, counts and layout")
+    p.add_argument("-o", "--output", required=True, metavar="OUT", help="calibration YAML to write")
+    p.add_argument("--name", help="station name written to OUT (default: OUT's file name without extension)")
+    p.set_defaults(func=_run_calibrate)
+
+
+def _run_calibrate(args: argparse.Namespace) -> int:
+    from ur3hanoi.calibrate import fit_station, load_taught, taught_from_table, write_calibration
+    from ur3hanoi.errors import TaughtPointsError
+    from ur3hanoi.station import load_station
+
+    if args.from_table is not None and args.key is None:
+        raise TaughtPointsError("--from-table needs --key (sim_pos or real_pos)")
+    if args.taught is not None and args.key is not None:
+        raise TaughtPointsError("--key is only used with --from-table")
+    inputs = [args.base, args.taught or args.from_table]
+    out = Path(args.output)
+    if any(out.exists() and Path(f).exists() and out.resolve() == Path(f).resolve() for f in inputs):
+        raise TaughtPointsError(f"output {args.output} is one of the input files: choose another -o")
+    base = load_station(args.base)
+    if args.taught is not None:
+        taught = load_taught(args.taught)
+        taught_label = Path(args.taught).as_posix()
+    else:
+        taught = taught_from_table(args.from_table, args.key)
+        taught_label = f"{Path(args.from_table).as_posix()} key {args.key}"
+    fit = fit_station(base, taught, name=args.name or out.stem, source=str(args.output))
+    write_calibration(out, fit, taught, base, taught_label=taught_label, base_label=Path(args.base).as_posix())
+
+    print(f"{'point':>6} {'tower':>5} {'height':>6} {'pose':>5} {'res [mm]':>9} {'dx':>7} {'dy':>7} {'dz':>7} "
+          f"{'yaw [deg]':>9} {'tilt':>6}")
+    for r in fit.residual_table():
+        print(f"{r.index:>6} {r.tower:>5} {r.height:>6} {r.pose:>5} {r.residual_mm:>9.3f} {r.dx_mm:>7.3f} "
+              f"{r.dy_mm:>7.3f} {r.dz_mm:>7.3f} {r.yaw_dev_deg:>9.3f} {r.tilt_deg:>6.2f}{'  <-' if r.flagged else ''}")
+    for w in fit.warnings:
+        print(f"ur3hanoi: warning: {w}", file=sys.stderr)
+    exact = " (exact fit: add points to check it)" if fit.dof == 0 else ""
+    print(f"wrote {args.output}: fitted {', '.join(fit.fitted_params)} from {len(fit.points)} points, "
+          f"residual rms {fit.rms_mm:.3f} mm, max {fit.max_mm:.3f} mm{exact}; {len(fit.warnings)} warning(s)")
+    return 0
+
+
 # ------------------------------------------------------------------------------------------------------- main
 
-_COMMANDS = [_add_tables, _add_check_table]
+_COMMANDS = [_add_tables, _add_check_table, _add_calibrate]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,428 @@
+"""Station calibration from taught poses: synthetic stations taught by IK, fitted back, tables regenerated."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import yaml
+
+from ur3hanoi.calibrate import (
+    RESIDUAL_WARN_MM,
+    CalibrationFit,
+    TaughtPoint,
+    TaughtPoints,
+    fit_station,
+    load_taught,
+    taught_from_table,
+)
+from ur3hanoi.cli import main
+from ur3hanoi.errors import IKError, TaughtPointsError
+from ur3hanoi.grid import ABOVE, ON, R_world_tcp_down, T_world_tcp
+from ur3hanoi.ik import make_solver, solve_on_branch
+from ur3hanoi.robot import load_ur3
+from ur3hanoi.station import Station, load_station, station_to_dict
+from ur3hanoi.table import generate_table, read_table
+
+from .conftest import LAB_REAL, LAB_SIM, REPO
+
+Slot = tuple[int, int, int]  # (tower, height, k)
+MINIMAL: tuple[Slot, ...] = ((0, 0, ON), (1, 0, ON), (2, 0, ON))
+FULL: tuple[Slot, ...] = tuple((t, h, k) for t in range(3) for h in range(3) for k in (ON, ABOVE))
+LAB_TABLE = REPO / "tables/lab2_data.yaml"
+
+
+# ------------------------------------------------------------------------------------------------- helpers
+
+
+def teach_q(station: Station, slot: Slot, offset: Sequence[float] = (0.0, 0.0, 0.0),
+            R_tilt: np.ndarray | None = None) -> np.ndarray:
+    """Joint angles [rad] that put the TCP at the slot's true pose, moved by ``offset`` [m, world]."""
+    target = T_world_tcp(station, *slot)
+    R = target.rotation if R_tilt is None else target.rotation @ R_tilt
+    T_world = pin.SE3(R, target.translation + np.asarray(offset, dtype=float))
+    solver = make_solver("pinocchio", load_ur3(station.tool, station.limits))
+    return solve_on_branch(solver, station.T_world_base.actInv(T_world), station.q_home_array, label=str(slot)).q
+
+
+def random_unit(rng: np.random.Generator) -> np.ndarray:
+    v = rng.normal(size=3)
+    return v / np.linalg.norm(v)
+
+
+def teach(station: Station, slots: Sequence[Slot], rng: np.random.Generator | None = None,
+          noise_m: float = 0.0, moved: dict[int, np.ndarray] | None = None) -> TaughtPoints:
+    """Taught points for ``slots``; each suction point moved by ``noise_m`` [m] in a random direction, and the
+    points in ``moved`` by the given world offset [m]."""
+    points = []
+    for i, slot in enumerate(slots):
+        offset = noise_m * random_unit(rng) if noise_m > 0 and rng is not None else np.zeros(3)
+        if moved and i in moved:
+            offset = offset + moved[i]
+        points.append(TaughtPoint(index=i, tower=slot[0], height=slot[1], k=slot[2],
+                                  q=tuple(float(v) for v in teach_q(station, slot, offset))))
+    return TaughtPoints(points=tuple(points), source="<test>", sha256="")
+
+
+def synthetic_station(rng: np.random.Generator, base: Station) -> Station:
+    """A random stacked station within reach: uneven towers, random block size, tool yaw and approach."""
+    for _ in range(100):
+        block = float(rng.uniform(0.025, 0.045))
+        depth = float(rng.uniform(0.001, 0.006))
+        yaw = float(rng.uniform(-math.pi, math.pi))
+        x0 = float(rng.uniform(0.18, 0.32))
+        ys = float(rng.uniform(-0.28, -0.12)) + np.cumsum([0.0, *rng.uniform(0.05, 0.15, size=2)])
+        origins = [(x0 + float(rng.uniform(-0.03, 0.03)), float(y), block - depth) for y in ys]
+        st = replace(base, block_size=block, contact_depth=depth, name="synthetic")
+        st = st.with_grid(origins, (0.0, 0.0, block), yaw, float(rng.uniform(0.05, 0.11)))
+        try:
+            generate_table(st)
+        except IKError:
+            continue  # out of reach on home's branch: draw another station
+        return st
+    raise AssertionError("no reachable synthetic station in 100 draws")
+
+
+def contact_errors_m(truth: Station, fitted: Station, ks: Sequence[int] = (ON,)) -> np.ndarray:
+    """FK position error [m] of the fitted station's regenerated table against the true grid, per pose."""
+    table = generate_table(fitted)
+    robot = load_ur3(truth.tool, truth.limits)
+    errs = []
+    for t in range(truth.n_towers):
+        for h in range(truth.n_heights):
+            for k in ks:
+                T = truth.T_world_base * robot.fk(table.q[t, h, k])
+                errs.append(np.linalg.norm(T.translation - T_world_tcp(truth, t, h, k).translation))
+    return np.array(errs)
+
+
+def write_taught(path: Path, taught: TaughtPoints, units: str = "deg") -> Path:
+    scale = 180.0 / math.pi if units == "deg" else 1.0
+    pts = []
+    for p in taught.points:
+        item: dict[str, object] = {"tower": p.tower, "height": p.height}
+        if p.k == ABOVE:
+            item["pose"] = "above"
+        item["q"] = [float(v * scale) for v in p.q]
+        pts.append(item)
+    path.write_text(yaml.safe_dump({"units": units, "points": pts}, sort_keys=False))
+    return path
+
+
+def run_cli(argv: Sequence[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    rc = main(list(argv))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+@pytest.fixture(scope="module")
+def real_base() -> Station:
+    return load_station(LAB_REAL)
+
+
+@pytest.fixture(scope="module")
+def truth(real_base: Station) -> Station:
+    return synthetic_station(np.random.default_rng(1234), real_base)
+
+
+@pytest.fixture(scope="module")
+def truth_base(truth: Station, real_base: Station) -> Station:
+    """lab_real with the truth's blocks (its own tower origins): what a station's owner would start from."""
+    return replace(real_base, block_size=truth.block_size, contact_depth=truth.contact_depth,
+                   height_step=(0.0, 0.0, truth.block_size))
+
+
+def write_base(path: Path, station: Station) -> Path:
+    path.write_text(yaml.safe_dump(station_to_dict(station), sort_keys=False))
+    return path
+
+
+# ------------------------------------------------------------------------------------------------- fitting
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_minimal_workflow_reproduces_a_random_station(real_base: Station, seed: int) -> None:
+    truth = synthetic_station(np.random.default_rng(seed), real_base)
+    # The base's block size is the truth's: only the grid is taken from the points.
+    base = replace(real_base, block_size=truth.block_size, contact_depth=truth.contact_depth)
+    fit = fit_station(base, teach(truth, MINIMAL))
+    assert fit.fitted_params == ("tower_origins", "tool_yaw")
+    assert fit.dof == 0
+    assert fit.station.height_step == pytest.approx((0.0, 0.0, truth.block_size), abs=1e-12)
+    assert math.cos(fit.station.tool_yaw - truth.tool_yaw) == pytest.approx(1.0, abs=1e-12)
+    assert np.max(contact_errors_m(truth, fit.station)) < 1e-6
+
+
+@pytest.mark.parametrize("seed", [10, 11, 12])
+def test_full_points_fit_step_and_approach_exactly(real_base: Station, seed: int) -> None:
+    truth = synthetic_station(np.random.default_rng(seed), real_base)
+    base = replace(real_base, block_size=truth.block_size, contact_depth=truth.contact_depth)
+    fit = fit_station(base, teach(truth, FULL))
+    assert fit.fitted_params == ("tower_origins", "height_step", "tool_yaw", "approach")
+    assert np.max(fit.residuals_mm) < 1e-6
+    np.testing.assert_allclose(fit.station.tower_origins, truth.tower_origins, atol=1e-9)
+    np.testing.assert_allclose(fit.station.height_step, truth.height_step, atol=1e-9)
+    assert fit.station.approach == pytest.approx(truth.approach, abs=1e-9)
+    assert np.max(contact_errors_m(truth, fit.station, ks=(ON, ABOVE))) < 1e-6
+
+
+@pytest.mark.parametrize(("slots", "ks"), [(MINIMAL, (ON,)), (FULL, (ON, ABOVE))], ids=["minimal", "full"])
+@pytest.mark.parametrize("seed", [20, 21, 22])
+def test_one_mm_noise_stays_within_1p5_mm(real_base: Station, slots: tuple[Slot, ...], ks: tuple[int, ...],
+                                          seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    truth = synthetic_station(rng, real_base)
+    base = replace(real_base, block_size=truth.block_size, contact_depth=truth.contact_depth)
+    fit = fit_station(base, teach(truth, slots, rng, noise_m=0.001))
+    errs = contact_errors_m(truth, fit.station, ks=ks)
+    assert np.max(errs) < 1.5e-3, f"worst regenerated pose off by {np.max(errs) * 1e3:.3f} mm"
+    # 1 mm noise never looks like a mis-recorded point.
+    assert not any("residual" in w for w in fit.warnings)
+
+
+def test_outlier_is_named_in_the_residual_report(truth: Station, truth_base: Station) -> None:
+    # Every slot taught twice (a common habit: teach, move away, teach again): 36 points, 13 unknowns.
+    slots = FULL + FULL
+    outlier = 8  # tower 1 height 1 on, first teaching
+    base = truth_base
+    taught = teach(truth, slots, np.random.default_rng(5), noise_m=0.0003,
+                   moved={outlier: np.array([0.006, -0.008, 0.0])})  # 10 mm
+    fit = fit_station(base, taught)
+    assert int(np.argmax(fit.residuals_mm)) == outlier
+    assert fit.residuals_mm[outlier] > 7.0
+    flagged = [r.index for r in fit.residual_table() if r.flagged]
+    assert flagged == [outlier]
+    assert len(fit.warnings) == 1
+    assert "points[8] (tower 1 height 1 on): residual" in fit.warnings[0]
+    assert np.sort(fit.residuals_mm)[-2] < RESIDUAL_WARN_MM
+    # Without the outlier's influence the grid is still close: the other slot of tower 1 height 1 agrees.
+    clean = fit_station(base, TaughtPoints(tuple(p for p in taught.points if p.index != outlier), "<t>", ""))
+    assert np.max(contact_errors_m(truth, clean.station)) < 0.5e-3
+
+
+def test_residual_table_rows_match_points(truth: Station, truth_base: Station) -> None:
+    fit = fit_station(truth_base, teach(truth, FULL[:8] + MINIMAL))
+    rows = fit.residual_table()
+    assert [(r.index, r.tower, r.height, r.pose) for r in rows] == [
+        (p.index, p.tower, p.height, ("on", "above")[p.k]) for p in fit.points]
+    assert [r.residual_mm for r in rows] == pytest.approx(list(fit.residuals_mm), abs=1e-12)
+    assert fit.measured.shape == fit.fitted.shape == (len(fit.points), 3)
+    assert isinstance(fit, CalibrationFit)
+
+
+def test_yaw_is_the_circular_mean_and_deviations_warn(truth: Station, truth_base: Station) -> None:
+    # Headings +-3 deg about the true yaw: the mean is the truth; the point 3 deg off is warned about.
+    pts = list(teach(truth, MINIMAL).points)
+    for i, dyaw in ((0, 3.0), (1, -3.0)):
+        R = pin.utils.rotate("z", math.radians(dyaw))
+        target = T_world_tcp(truth, pts[i].tower, 0, ON)
+        T = pin.SE3(R @ target.rotation, target.translation)
+        solver = make_solver("pinocchio", load_ur3(truth.tool, truth.limits))
+        q = solve_on_branch(solver, truth.T_world_base.actInv(T), truth.q_home_array).q
+        pts[i] = replace(pts[i], q=tuple(float(v) for v in q))
+    fit = fit_station(truth_base, pts)
+    assert math.degrees(float(np.angle(np.exp(1j * (fit.station.tool_yaw - truth.tool_yaw))))) == pytest.approx(
+        0.0, abs=1e-2)
+    assert fit.yaw_dev_deg[:2] == pytest.approx([3.0 - 0.0, -3.0], abs=0.05)
+    assert sum("tool heading" in w for w in fit.warnings) == 2
+
+
+def test_flat_layout_default_step_turns_with_the_tower_row() -> None:
+    base = load_station(LAB_SIM)
+    turn = math.radians(15.0)
+    Rz = pin.utils.rotate("z", turn)
+    pivot = np.array(base.tower_origins[1])
+    origins = [pivot + Rz @ (np.array(o) - pivot) for o in base.tower_origins]
+    truth = base.with_grid(origins, Rz @ np.array(base.height_step), base.tool_yaw + turn)
+    fit = fit_station(base, teach(truth, MINIMAL))
+    assert "height_step" not in fit.fitted_params
+    np.testing.assert_allclose(fit.station.height_step, truth.height_step, atol=1e-9)
+    assert np.max(contact_errors_m(truth, fit.station)) < 1e-6
+
+
+def test_flat_layout_fits_a_horizontal_step(lab_sim: Station) -> None:
+    taught = taught_from_table(LAB_TABLE, "sim_pos")
+    fit = fit_station(lab_sim, taught)
+    assert "height_step" in fit.fitted_params
+    np.testing.assert_allclose(fit.station.height_step, lab_sim.height_step, atol=1e-9)
+    np.testing.assert_allclose(fit.station.tower_origins, lab_sim.tower_origins, atol=1e-9)
+
+
+def test_from_table_round_trip_real_pos(real_base: Station) -> None:
+    fit = fit_station(real_base, taught_from_table(LAB_TABLE, "real_pos"))
+    assert len(fit.points) == 18
+    np.testing.assert_allclose(fit.station.tower_origins, real_base.tower_origins, atol=1e-6)
+    np.testing.assert_allclose(fit.station.height_step, real_base.height_step, atol=1e-6)
+    assert fit.station.approach == pytest.approx(real_base.approach, abs=1e-6)
+    assert math.cos(fit.station.tool_yaw - real_base.tool_yaw) == pytest.approx(1.0, abs=1e-12)
+
+
+def test_underdetermined_points_are_refused(truth: Station, truth_base: Station) -> None:
+    only_above = [(t, 0, ABOVE) for t in range(3)]
+    with pytest.raises(TaughtPointsError, match="do not determine the grid"):
+        fit_station(truth_base, teach(truth, only_above))
+
+
+# ------------------------------------------------------------------------------------------------------ CLI
+
+
+def test_cli_calibrate_then_tables_end_to_end(truth: Station, truth_base: Station, tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    base_file = write_base(tmp_path / "base.yaml", truth_base)
+    # The base's grid is not the truth's: the fit must come from the taught points.
+    assert np.max(np.abs(np.subtract(load_station(base_file).tower_origins, truth.tower_origins))) > 0.01
+    taught_file = write_taught(tmp_path / "taught.yaml", teach(truth, (*MINIMAL, (0, 2, ON), (1, 0, ABOVE))))
+    out = tmp_path / "station.yaml"
+    rc, stdout, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(base_file), "-o", str(out)],
+                              capsys)
+    assert rc == 0, err
+    assert "wrote" in stdout and "0 warning(s)" in stdout
+    text = out.read_text()
+    assert hashlib.sha256(taught_file.read_bytes()).hexdigest() in text.splitlines()[1]
+    assert hashlib.sha256(base_file.read_bytes()).hexdigest() in text.splitlines()[2]
+    fitted = load_station(out)
+    assert fitted.name == "station"
+    assert fitted.approach == pytest.approx(truth.approach, abs=1e-9)
+    np.testing.assert_allclose(fitted.tower_origins, truth.tower_origins, atol=1e-9)
+
+    table_file = tmp_path / "lab2_data.yaml"
+    rc, _, err = run_cli(["tables", str(out), "--key", "real_pos", "-o", str(table_file)], capsys)
+    assert rc == 0, err
+    q = read_table(table_file, "real_pos")
+    robot = load_ur3(truth.tool, truth.limits)
+    for t in range(3):
+        for h in range(3):
+            for k in (ON, ABOVE):
+                T = truth.T_world_base * robot.fk(q[t, h, k])
+                assert np.linalg.norm(T.translation - T_world_tcp(truth, t, h, k).translation) < 1e-6
+
+    # Deterministic: same inputs, same bytes.
+    out2 = tmp_path / "again" / "station.yaml"
+    rc, _, _ = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(base_file), "-o", str(out2)],
+                       capsys)
+    assert rc == 0
+    assert out2.read_bytes() == out.read_bytes()
+
+
+def test_cli_from_table_round_trip(tmp_path: Path, capsys: pytest.CaptureFixture[str], real_base: Station) -> None:
+    out = tmp_path / "real.yaml"
+    rc, stdout, err = run_cli(["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos",
+                               "--base", str(LAB_REAL), "-o", str(out)], capsys)
+    assert rc == 0, err
+    assert "from 18 points" in stdout
+    st = load_station(out)
+    np.testing.assert_allclose(st.tower_origins, real_base.tower_origins, atol=1e-6)
+    np.testing.assert_allclose(st.height_step, real_base.height_step, atol=1e-6)
+    assert st.approach == pytest.approx(real_base.approach, abs=1e-6)
+    assert f"sha256 {hashlib.sha256(LAB_TABLE.read_bytes()).hexdigest()}" in out.read_text()
+
+
+def test_cli_prints_outlier_warning(truth: Station, truth_base: Station, tmp_path: Path,
+                                    capsys: pytest.CaptureFixture[str]) -> None:
+    base_file = write_base(tmp_path / "base.yaml", truth_base)
+    taught = teach(truth, FULL + FULL, moved={3: np.array([0.0, 0.0, 0.010])})
+    taught_file = write_taught(tmp_path / "taught.yaml", taught, units="rad")
+    rc, _, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(base_file),
+                          "-o", str(tmp_path / "o.yaml")], capsys)
+    assert rc == 0
+    assert "ur3hanoi: warning: points[3] (tower 0 height 1 above): residual" in err
+    assert err.count("residual") == 1
+
+
+def _tilted_q(truth: Station) -> list[float]:
+    R_tilt = pin.utils.rotate("x", math.radians(20.0))
+    return [math.degrees(v) for v in teach_q(truth, (1, 0, ON), R_tilt=R_tilt)]
+
+
+BAD_INPUTS = {
+    # name: (taught-file text or None for a missing file, message fragment)
+    "missing-tower": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0}\n- {tower: 1, height: 0, q: Q1}\n",
+                      "tower 2 has no taught point (towers taught: [0, 1]"),
+    "joint-count": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0}\n"
+                    "- {tower: 1, height: 0, q: [1, 2, 3, 4, 5]}\n", "points[1]: 'q' has 5 joint values, expected 6"),
+    "degrees-as-rad": ("units: rad\npoints:\n- {tower: 0, height: 0, q: Q0}\n", "looks like degrees"),
+    "radians-as-deg": ("units: deg\npoints:\n- {tower: 0, height: 0, q: [2.1, -1.5, 1.6, -1.6, -1.6, 0.5]}\n",
+                       "looks like radians"),
+    "tilted": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0}\n- {tower: 1, height: 0, q: QT}\n"
+               "- {tower: 2, height: 0, q: Q2}\n", "points[1] (tower 1 height 0 on): the tool is tilted 20.0 deg"),
+    "unknown-units": ("units: grad\npoints:\n- {tower: 0, height: 0, q: Q0}\n", "'units' = 'grad' is invalid"),
+    "missing-units": ("points:\n- {tower: 0, height: 0, q: Q0}\n", "'units' = None is invalid"),
+    "tower-outside": ("units: deg\npoints:\n- {tower: 3, height: 0, q: Q0}\n",
+                      "tower 3 is outside the base calibration's grid (towers 0..2"),
+    "height-outside": ("units: deg\npoints:\n- {tower: 0, height: 3, q: Q0}\n",
+                       "height 3 is outside the base calibration's grid (heights 0..2"),
+    "bad-pose": ("units: deg\npoints:\n- {tower: 0, height: 0, pose: over, q: Q0}\n", "'pose' = 'over' is invalid"),
+    "not-a-list": ("units: deg\npoints: 3\n", "'points' = 3 is invalid"),
+    "malformed-yaml": ("units: deg\npoints: [\n", "not valid YAML"),
+    "missing-file": (None, "cannot read taught-points file"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_INPUTS))
+def test_cli_bad_taught_input_exits_2_without_output(case: str, truth: Station, tmp_path: Path,
+                                                     capsys: pytest.CaptureFixture[str]) -> None:
+    text, fragment = BAD_INPUTS[case]
+    taught_file = tmp_path / "taught.yaml"
+    if text is not None:
+        qs = {f"Q{t}": str([math.degrees(v) for v in teach_q(truth, (t, 0, ON))]) for t in range(3)}
+        if "QT" in text:
+            qs["QT"] = str(_tilted_q(truth))
+        for key, val in qs.items():
+            text = text.replace(f"q: {key}", f"q: {val}")
+        taught_file.write_text(text)
+    out = tmp_path / "out.yaml"
+    rc, _, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(LAB_REAL), "-o", str(out)],
+                         capsys)
+    assert rc == 2
+    assert err.startswith("ur3hanoi: error: ") and err.count("\n") == 1, err
+    assert fragment in err
+    assert not out.exists()
+    assert list(tmp_path.iterdir()) == ([taught_file] if text is not None else [])
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["--from-table", str(LAB_TABLE), "--base", str(LAB_REAL)], "--from-table needs --key"),
+        (["--from-table", str(LAB_TABLE), "--key", "nope", "--base", str(LAB_REAL)], "key 'nope' not found"),
+        (["--from-table", str(LAB_TABLE), "--key", "real_pos", "--base", "no/such/base.yaml"],
+         "no/such/base.yaml: field '<file>'"),
+    ],
+    ids=["no-key", "unknown-key", "missing-base"],
+)
+def test_cli_bad_table_or_base_exits_2(args: list[str], fragment: str, tmp_path: Path,
+                                       capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out.yaml"
+    rc, _, err = run_cli(["calibrate", *args, "-o", str(out)], capsys)
+    assert rc == 2
+    assert err.startswith("ur3hanoi: error: ") and fragment in err
+    assert not out.exists()
+
+
+def test_cli_error_leaves_existing_output_untouched(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out.yaml"
+    out.write_text("previous\n")
+    taught_file = tmp_path / "t.yaml"
+    taught_file.write_text("units: rad\npoints:\n- {tower: 0, height: 0, q: [120, -90, 90, -90, -90, 0]}\n")
+    rc, _, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(LAB_REAL), "-o", str(out)],
+                         capsys)
+    assert rc == 2 and "looks like degrees" in err
+    assert out.read_text() == "previous\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.yaml", "t.yaml"]
+
+
+def test_load_taught_converts_degrees(tmp_path: Path) -> None:
+    f = tmp_path / "t.yaml"
+    f.write_text("units: deg\npoints:\n- {tower: 0, height: 1, pose: above, q: [120, -90, 90, -90, -90, 0]}\n")
+    taught = load_taught(f)
+    (p,) = taught.points
+    assert (p.tower, p.height, p.k) == (0, 1, ABOVE)
+    assert p.q == pytest.approx([math.radians(v) for v in (120, -90, 90, -90, -90, 0)], abs=1e-15)
+    assert taught.sha256 == hashlib.sha256(f.read_bytes()).hexdigest()
+    assert R_world_tcp_down(0.0)[2, 2] == -1.0  # sanity of the helper the fit's tilt check relies on
