@@ -146,9 +146,207 @@ def _run_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+# ------------------------------------------------------------------------------------------------------ solve
+
+
+def _add_solve(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("solve", help="run the lab in MuJoCo: plan, execute with suction feedback, verify",
+                       description="Solve the Tower of Hanoi in a MuJoCo simulation of the station: the UR3 "
+                                   "follows the planned trajectory, the suction cup grasps by weld, and the "
+                                   "program halts like the lab's (suction off, arm home, exit 3) when a block is "
+                                   "missing or dropped. Towers, heights and moves are numbered from 1. Without "
+                                   "--start/--end it prompts on a terminal like the lab program.")
+    p.add_argument("--start", type=int, metavar="S", help="start tower (1-based)")
+    p.add_argument("--end", type=int, metavar="E", help="destination tower (1-based)")
+    p.add_argument("--blocks", type=int, default=3, metavar="N", help="number of blocks (default 3)")
+    p.add_argument("--calibration", default=None, metavar="CAL",
+                   help=f"station calibration YAML (default {DEFAULT_CALIBRATION})")
+    p.add_argument("--remove-block", type=int, metavar="H",
+                   help="fault injection: spawn without the block at height H (1-based), like lab2_spawn.py")
+    p.add_argument("--drop-during-move", type=int, metavar="M",
+                   help="fault injection: the suction loses its block in the middle of move M's carry (1-based)")
+    p.add_argument("--speed", type=_positive_float, default=1.0, metavar="F",
+                   help="fraction of the joint speed/acceleration/jerk limits, 0 < F <= 1 (default 1)")
+    p.add_argument("--seed", type=int, default=0, metavar="K", help="seed of the suction feedback noise")
+    out = p.add_mutually_exclusive_group()
+    out.add_argument("--video", metavar="FILE.mp4",
+                     help="render an MP4 offscreen (needs imageio + imageio-ffmpeg; headless: MUJOCO_GL=egl)")
+    out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR (headless: MUJOCO_GL=egl)")
+    p.add_argument("--view", action="store_true", help="open MuJoCo's interactive viewer (needs a display)")
+    p.add_argument("--json", action="store_true", help="print one JSON object with the outcome on stdout")
+    p.set_defaults(func=_run_solve)
+
+
+def _solve_calibration_path(arg: str | None) -> Path:
+    """``--calibration``, or the default resolved against the repository when the cwd lacks it."""
+    if arg is not None:
+        return Path(arg)
+    path = Path(DEFAULT_CALIBRATION)
+    return path if path.exists() else Path(__file__).resolve().parents[1] / DEFAULT_CALIBRATION
+
+
+def _solve_prompt_tower(what: str, n_towers: int, exclude: int | None = None) -> int:
+    """Prompt like the lab program until a valid tower (1-based) is entered; returns it 0-based."""
+    choices = " ".join(str(t) for t in range(1, n_towers + 1) if t - 1 != exclude)
+    options = choices.rsplit(" ", 1)
+    label = f"{options[0]} or {options[1]}" if len(options) == 2 else choices
+    while True:
+        try:
+            text = input(f"Enter the {what} tower <{label}> ")
+        except EOFError:
+            raise Ur3HanoiError(f"no {what} tower entered (end of input)") from None
+        text = text.strip()
+        if text.isdigit() and 1 <= int(text) <= n_towers and int(text) - 1 != exclude:
+            return int(text) - 1
+        print(f"Please just enter the character {label}\n")
+
+
+def _solve_progress(fraction: float, label: str) -> None:
+    width = 30
+    filled = round(width * fraction)
+    end = "\n" if fraction >= 1.0 else ""
+    print(f"\r[{'#' * filled}{'.' * (width - filled)}] {100 * fraction:5.1f}% {label:<12}", end=end,
+          file=sys.stderr, flush=True)
+
+
+def _run_solve(args: argparse.Namespace) -> int:
+    import json
+    import os
+
+    from ur3hanoi.hanoi import validate_instance
+    from ur3hanoi.station import load_station
+
+    station = load_station(_solve_calibration_path(args.calibration))
+    n_towers = station.n_towers
+    if args.start is None or args.end is None:
+        if not sys.stdin.isatty():
+            raise Ur3HanoiError("--start and --end are required when stdin is not a terminal "
+                                f"(towers 1..{n_towers}), e.g. ur3hanoi solve --start 1 --end 3")
+        start = args.start - 1 if args.start is not None else _solve_prompt_tower("start", n_towers)
+        end = args.end - 1 if args.end is not None else _solve_prompt_tower("end", n_towers, exclude=start)
+    else:
+        start, end = args.start - 1, args.end - 1
+    validate_instance(args.blocks, start, end, n_towers, station.n_heights)
+    if not args.speed <= 1.0:
+        raise Ur3HanoiError(f"--speed {args.speed} is invalid: expected 0 < F <= 1")
+    n_moves = 2**args.blocks - 1
+    if args.remove_block is not None and not 1 <= args.remove_block <= args.blocks:
+        raise Ur3HanoiError(f"--remove-block {args.remove_block} is invalid: expected a height 1..{args.blocks}")
+    if args.drop_during_move is not None and not 1 <= args.drop_during_move <= n_moves:
+        raise Ur3HanoiError(f"--drop-during-move {args.drop_during_move} is invalid: expected a move 1..{n_moves}")
+    if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
+        os.environ["MUJOCO_GL"] = "egl"  # headless offscreen rendering (read when the GL context is created)
+
+    from ur3hanoi.plan import PlanConfig
+    from ur3hanoi.sim import (
+        Faults,
+        OffscreenRecorder,
+        SimConfig,
+        ViewerSink,
+        build_task_scene,
+        display_available,
+        make_plan,
+        run_plan,
+    )
+
+    if args.view and display_available() is not None:
+        raise Ur3HanoiError(f"--view cannot open the MuJoCo viewer: {display_available()}")
+    faults = Faults(
+        remove_block=None if args.remove_block is None else args.remove_block - 1,
+        drop_during_move=None if args.drop_during_move is None else args.drop_during_move - 1,
+    )
+    config = SimConfig(seed=args.seed)
+    plan = make_plan(station, start, end, args.blocks, PlanConfig(speed=args.speed))
+    scene = build_task_scene(station, start, args.blocks, faults.remove_block, config.scene)
+    sink: object | None = None
+    try:
+        if args.view:
+            sink = ViewerSink(scene.model, scene.data)
+        elif args.video or args.frames:
+            sink = OffscreenRecorder(station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
+                                     video=Path(args.video) if args.video else None)
+        progress = _solve_progress if sys.stderr.isatty() and not args.view else None
+        result = run_plan(plan, faults, config, frames=sink, progress=progress,  # type: ignore[arg-type]
+                          scene=scene, realtime=args.view)
+    finally:
+        if sink is not None:
+            sink.close()  # type: ignore[attr-defined]
+
+    if args.json:
+        print(json.dumps(result.as_dict()))
+    else:
+        print(f"{result.status}: {result.moves_completed}/{result.moves_total} moves, tower {start + 1} -> "
+              f"{end + 1}, {len(result.final_blocks)} blocks on {station.name}")
+        for b in result.final_blocks:
+            where = f"tower {b.tower + 1} height {b.height + 1}" if b.tower is not None else "in no slot"
+            print(f"  block {b.block + 1} ({b.as_dict()['colour']}): {where} at "
+                  f"[{b.xyz[0]:.4f}, {b.xyz[1]:.4f}, {b.xyz[2]:.4f}] m")
+        print(f"  sim {result.sim_time_s:.2f} s in {result.wall_time_s:.2f} s wall ({result.realtime_factor:.1f}x "
+              f"real time), max tracking error {math.degrees(result.max_tracking_error_rad):.3f} deg, suction "
+              f"{'on' if result.suction_on_at_end else 'off'}, {'at' if result.at_home_at_end else 'not at'} home")
+        if args.video or args.frames:
+            print(f"  wrote {sink.count} frames to {args.video or args.frames}")  # type: ignore[union-attr]
+    if result.error is not None:
+        print(f"ur3hanoi: error: {result.error}", file=sys.stderr)
+    return result.exit_code
+
+
+# ------------------------------------------------------------------------------------------------------- plan
+
+
+def _add_plan(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("plan", help="solve a Hanoi instance and time-parameterize the motion with Ruckig",
+                       description="Solve the Tower of Hanoi from --start to --end (towers and blocks numbered "
+                                   "from 1) and plan the whole motion with Ruckig under the UR3's limits "
+                                   "(pass-through above the towers, exact vertical approach), checked for "
+                                   "joint limits, velocity/acceleration/jerk and clearances.")
+    p.add_argument("--start", type=int, required=True, help="start tower (1-based)")
+    p.add_argument("--end", type=int, required=True, help="end tower (1-based)")
+    p.add_argument("--blocks", type=int, default=None, help="number of blocks (default: the grid's heights)")
+    p.add_argument("--calibration", default=DEFAULT_CALIBRATION, help=f"station YAML (default {DEFAULT_CALIBRATION})")
+    p.add_argument("--speed", type=_positive_float, default=1.0,
+                   help="scale of the velocity, acceleration and jerk limits, 0 < F <= 1 (default 1)")
+    p.add_argument("--rate", type=_positive_float, default=125.0,
+                   help="sample rate [Hz]: 125 (CB3, default) or 500 (e-Series); any positive rate is accepted")
+    p.add_argument("--dwell", type=float, default=0.3, help="suction dwell at each contact [s] (default 0.3)")
+    p.add_argument("--csv", metavar="FILE", help="write t,q1..q6,qd1..qd6,suction samples to FILE (atomic)")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of a summary")
+    p.add_argument("--no-collision", action="store_true", help="skip the (slower) clearance checks")
+    p.set_defaults(func=_run_plan)
+
+
+def _run_plan(args: argparse.Namespace) -> int:
+    import json
+
+    from ur3hanoi.plan import PlanConfig, plan_solve, trajectory_csv
+    from ur3hanoi.station import load_station
+    from ur3hanoi.table import atomic_write
+
+    station = load_station(args.calibration)
+    n_blocks = station.n_heights if args.blocks is None else args.blocks
+    config = PlanConfig(speed=args.speed, rate_hz=args.rate, dwell_s=args.dwell,
+                        check_collisions=not args.no_collision)
+    plan = plan_solve(station, args.start - 1, args.end - 1, n_blocks, config)
+    if args.csv:
+        atomic_write(args.csv, trajectory_csv(plan.trajectory))
+    if args.json:
+        print(json.dumps(plan.to_json_dict()))
+        return 0
+    print(f"{station.name}: {n_blocks} blocks, tower {args.start} -> {args.end}: {len(plan.moves)} moves")
+    for i, m in enumerate(plan.moves, start=1):
+        d = m.as_lab_dict()
+        print(f"  {i:>3}. block {d['block']}: tower {d['from_tower']} height {d['from_height']} -> "
+              f"tower {d['to_tower']} height {d['to_height']}")
+    print(f"cycle {plan.duration_s:.3f} s (motion {plan.motion_s:.3f} s), stop-and-go {plan.stop_and_go_duration_s:.3f}"
+          f" s (motion {plan.stop_and_go_motion_s:.3f} s): {100 * plan.motion_saving:.1f} % less motion time")
+    print(f"{len(plan.trajectory.t)} samples at {plan.trajectory.rate_hz:g} Hz, speed {args.speed:g}; all limit and "
+          "clearance checks passed" + (f"; wrote {args.csv}" if args.csv else ""))
+    return 0
+
+
 # ------------------------------------------------------------------------------------------------------- main
 
-_COMMANDS = [_add_tables, _add_check_table, _add_calibrate]
+_COMMANDS = [_add_tables, _add_check_table, _add_calibrate, _add_solve, _add_plan]
 
 
 def build_parser() -> argparse.ArgumentParser:

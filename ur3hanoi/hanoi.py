@@ -116,3 +116,17 @@ def check_sequence(moves: Sequence[Move], n_blocks: int, start: int, end: int, n
         dst.append(src.pop())
     if stacks[end] != list(range(n_blocks)):
         raise PuzzleError(f"after {len(moves)} moves the blocks are not all on tower {end + 1}: {stacks}")
+
+
+def stacks_before_moves(moves: Sequence[Move], n_blocks: int, start: int, n_towers: int) -> list[list[list[int]]]:
+    """Tower contents (bottom first, 0-based blocks) before each move, plus the final state: len(moves) + 1 entries.
+
+    The moves are replayed without legality checks (use :func:`check_sequence` for that).
+    """
+    stacks: list[list[int]] = [[] for _ in range(n_towers)]
+    stacks[start] = list(range(n_blocks))
+    out = [[list(s) for s in stacks]]
+    for m in moves:
+        stacks[m.to_tower].append(stacks[m.from_tower].pop())
+        out.append([list(s) for s in stacks])
+    return out

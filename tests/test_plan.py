@@ -1,0 +1,177 @@
+"""Ruckig motion plans: limits, endpoints, vertical approach, pass-through vs stop-and-go, clearances, CLI."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import itertools
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ur3hanoi.cli import main
+from ur3hanoi.errors import PlanError, PuzzleError
+from ur3hanoi.grid import ABOVE, ON
+from ur3hanoi.plan import Phase, Plan, PlanConfig, build_waypoints, check_vertical, plan_solve
+from ur3hanoi.station import Station, load_station
+
+ROOT = Path(__file__).resolve().parents[1]
+STATIONS = {name: ROOT / "robots/stations" / f"{name}.yaml" for name in ("lab_sim", "lab_real")}
+PAIRS = list(itertools.permutations(range(3), 2))
+
+
+@pytest.fixture(scope="module")
+def stations() -> dict[str, Station]:
+    return {name: load_station(path) for name, path in STATIONS.items()}
+
+
+@pytest.fixture(scope="module")
+def plans(stations: dict[str, Station]) -> dict[tuple[str, int, int, int], Plan]:
+    """Every start/end pair for N = 1..3 on both stations, planned once (with clearance checks)."""
+    return {(name, s, e, n): plan_solve(st_, s, e, n, PlanConfig())
+            for name, st_ in stations.items() for s, e in PAIRS for n in (1, 2, 3)}
+
+
+def _assert_limits(plan: Plan) -> None:
+    tr, lim = plan.trajectory, plan.limits
+    assert lim is not None
+    for arr, m in ((tr.qd, lim.v_max), (tr.qdd, lim.a_max), (tr.qddd, lim.j_max)):
+        assert np.all(np.abs(arr) <= m * (1 + 1e-6))
+    assert np.all(tr.q >= np.asarray(plan.station.limits.q_min)) and np.all(tr.q <= plan.station.limits.q_max)
+
+
+def test_all_pairs_plan_cleanly(plans: dict[tuple[str, int, int, int], Plan]) -> None:
+    assert len(plans) == 36
+    for (_, _, _, n), plan in plans.items():
+        assert len(plan.moves) == 2**n - 1
+        assert plan.violations == ()
+        _assert_limits(plan)
+
+
+def test_velocity_limits_are_the_datasheet(plans: dict[tuple[str, int, int, int], Plan]) -> None:
+    plan = plans[("lab_sim", 0, 2, 3)]
+    assert plan.limits is not None
+    np.testing.assert_allclose(plan.limits.v_max, [np.pi] * 3 + [2 * np.pi] * 3)
+
+
+def test_endpoints_reached(plans: dict[tuple[str, int, int, int], Plan]) -> None:
+    for (name, _, _, _), plan in plans.items():
+        wp = build_waypoints(plan.station)
+        tr = plan.trajectory
+        np.testing.assert_allclose(tr.q[0], wp.q_home, atol=1e-6)
+        np.testing.assert_allclose(tr.q[-1], wp.q_home, atol=1e-6)
+        assert not tr.suction[-1]
+        for seg in plan.segments:
+            if seg.trajectory is None:
+                continue
+            end = seg.trajectory.at_time(seg.duration)[0]
+            q_end = seg.path.evaluate(end[0])[0] if seg.path is not None else np.array(end)
+            np.testing.assert_allclose(q_end, seg.q_end, atol=1e-6, err_msg=f"{name} {seg.target}")
+        # Every move's on/above poses are the table's entries.
+        for i, m in enumerate(plan.moves):
+            segs = [s for s in plan.segments if s.move_index == i]
+            ph = {s.phase: s for s in segs}
+            np.testing.assert_allclose(ph[Phase.GRASP_DWELL].q_start, wp.table[m.from_tower, m.from_height, ON])
+            np.testing.assert_allclose(ph[Phase.TRANSIT].q_end, wp.table[m.from_tower, m.from_height, ABOVE])
+            np.testing.assert_allclose(ph[Phase.RELEASE_DWELL].q_start, wp.table[m.to_tower, m.to_height, ON])
+            np.testing.assert_allclose(ph[Phase.CARRY].q_end, wp.table[m.to_tower, m.to_height, ABOVE])
+
+
+def test_dwell_samples_rest_on_contact(plans: dict[tuple[str, int, int, int], Plan]) -> None:
+    plan = plans[("lab_real", 1, 0, 3)]
+    tr = plan.trajectory
+    for ph in (Phase.GRASP_DWELL, Phase.RELEASE_DWELL):
+        idx = tr.phase == int(ph)
+        assert np.all(tr.qd[idx] == 0.0)
+    assert np.all(tr.suction[tr.phase == int(Phase.CARRY)])
+    assert not np.any(tr.suction[tr.phase == int(Phase.TRANSIT)])
+
+
+def test_pass_through_beats_stop_and_go(plans: dict[tuple[str, int, int, int], Plan]) -> None:
+    for plan in plans.values():
+        assert plan.duration_s <= plan.stop_and_go_duration_s + 1e-9
+    lab = plans[("lab_sim", 0, 2, 3)]
+    assert lab.motion_saving >= 0.15
+    # No stop at a pass-through above point: the via velocity into each descend is non-zero.
+    descends = [s for s in lab.segments if s.phase == Phase.DESCEND_PICK]
+    assert any(np.linalg.norm(s.v_start) > 0.1 for s in descends)
+
+
+def test_vertical_approach_within_2mm(plans: dict[tuple[str, int, int, int], Plan]) -> None:
+    for plan in plans.values():
+        viol, worst = check_vertical(plan.trajectory, plan.moves, plan.station, 0.002)
+        assert viol == [] and worst < 0.002
+
+
+def test_tall_grid_all_heights(stations: dict[str, Station]) -> None:
+    tall = dataclasses.replace(stations["lab_real"], n_heights=5)
+    plan = plan_solve(tall, 0, 2, 5, PlanConfig(check_collisions=False))
+    assert len(plan.moves) == 31 and plan.violations == ()
+
+
+def test_puzzle_errors(stations: dict[str, Station]) -> None:
+    with pytest.raises(PuzzleError):
+        plan_solve(stations["lab_sim"], 1, 1, 2)
+    with pytest.raises(PuzzleError):
+        plan_solve(stations["lab_sim"], 0, 1, 4)
+    with pytest.raises(PuzzleError):
+        plan_solve(stations["lab_sim"], 0, 3, 2)
+
+
+def test_clearance_check_detects(stations: dict[str, Station]) -> None:
+    """An impossible 20 cm block clearance must be reported (the check is live)."""
+    cfg = PlanConfig(clearance_m=0.2, raise_on_violation=False)
+    plan = plan_solve(stations["lab_real"], 0, 2, 2, cfg)
+    assert any("carried_block" in v for v in plan.violations)
+    with pytest.raises(PlanError, match="carried_block"):
+        plan_solve(stations["lab_real"], 0, 2, 2, dataclasses.replace(cfg, raise_on_violation=True))
+
+
+def test_rate_500(stations: dict[str, Station]) -> None:
+    plan = plan_solve(stations["lab_sim"], 0, 1, 2, PlanConfig(rate_hz=500, check_collisions=False))
+    np.testing.assert_allclose(np.diff(plan.trajectory.t), 1 / 500)
+    _assert_limits(plan)
+
+
+@settings(max_examples=6, deadline=None)
+@given(speed=st.floats(0.2, 1.0), shift=st.tuples(st.floats(-0.03, 0.03), st.floats(-0.03, 0.03)),
+       pair=st.sampled_from(PAIRS))
+def test_limits_property(speed: float, shift: tuple[float, float], pair: tuple[int, int]) -> None:
+    base = load_station(STATIONS["lab_real"])
+    moved = base.with_grid([(x + shift[0], y + shift[1], z) for x, y, z in base.tower_origins], base.height_step,
+                           base.tool_yaw)
+    plan = plan_solve(moved, pair[0], pair[1], 2, PlanConfig(speed=speed, check_collisions=False))
+    _assert_limits(plan)
+    assert plan.duration_s <= plan.stop_and_go_duration_s + 1e-9
+
+
+# ----------------------------------------------------------------------------------------------------------- CLI
+
+
+def test_cli_exit_codes(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["plan", "--start", "1", "--end", "1", "--calibration", str(STATIONS["lab_sim"])]) == 2
+    assert "error" in capsys.readouterr().err
+    assert main(["plan", "--start", "1", "--end", "2", "--blocks", "4", "--calibration",
+                 str(STATIONS["lab_sim"])]) == 2
+
+
+def test_cli_json_and_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "plan.csv"
+    rc = main(["plan", "--start", "1", "--end", "3", "--blocks", "2", "--calibration", str(STATIONS["lab_sim"]),
+               "--csv", str(out), "--json"])
+    assert rc == 0
+    data = json.loads(capsys.readouterr().out)
+    for key in ("moves", "duration_s", "stop_and_go_duration_s", "rate_hz", "max_abs_velocity",
+                "max_abs_acceleration", "max_abs_jerk", "velocity_limit", "acceleration_limit", "jerk_limit",
+                "violations"):
+        assert key in data
+    assert data["moves"][0] == {"block": 2, "from_tower": 1, "from_height": 2, "to_tower": 2, "to_height": 1}
+    assert data["violations"] == [] and len(data["max_abs_jerk"]) == 6
+    with out.open() as f:
+        rows = list(csv.reader(f))
+    assert rows[0] == ["t", *(f"q{i}" for i in range(1, 7)), *(f"qd{i}" for i in range(1, 7)), "suction"]
+    assert {r[-1] for r in rows[1:]} == {"0", "1"}
