@@ -42,7 +42,7 @@ from ruckig import Trajectory as RuckigTrajectory
 from ur3hanoi.errors import SimulationError, SuctionFaultError, Ur3HanoiError
 from ur3hanoi.grid import block_center_world, table_z
 from ur3hanoi.hanoi import block_colour
-from ur3hanoi.plan import Phase, Plan, PlanConfig, Trajectory
+from ur3hanoi.plan import Phase, Plan, PlanConfig, Trajectory, plan_solve
 from ur3hanoi.robot import JOINT_NAMES, N_JOINTS, Q_HOME_LAB, T_BASELINK_BASE, ToolOffset, load_ur3, urdf_path
 from ur3hanoi.station import Station
 
@@ -729,6 +729,8 @@ class SimResult:
     fault_tower: int | None = None
     detection_latency_s: float | None = None
     warnings: dict[str, int] = field(default_factory=dict)
+    # gripper_input every control cycle: columns t [s], DIGIN, AIN0 [V] (for plots; not in the JSON).
+    feedback_trace: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
 
     @property
     def realtime_factor(self) -> float:
@@ -886,7 +888,10 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
     report_every = max(1, n // 50)
     prev_phase = int(tr.phase[0])
 
-    def step_cycle(ctrl_k: FloatArray, split_after: int = 0, on_split: Callable[[], None] | None = None) -> None:
+    trace: list[tuple[float, int, float]] = []  # (t [s], DIGIN, AIN0 [V]) every control cycle
+
+    def step_cycle(ctrl_k: FloatArray, split_after: int = 0,
+                   on_split: Callable[[], None] | None = None) -> GripperInput:
         nonlocal next_frame
         d.ctrl[act_ids] = ctrl_k
         if split_after and on_split is not None:
@@ -902,6 +907,9 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
             lag = d.time - (time.perf_counter() - wall0)
             if lag > 0:
                 time.sleep(lag)
+        fb = cup.feedback()  # the driver publishes gripper_input every cycle
+        trace.append((fb.t, fb.digin, fb.ain0))
+        return fb
 
     if frames is not None:
         frames(m, d)
@@ -914,7 +922,9 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
         want = bool(tr.suction[k])
         if want != cup.on:
             if not want and cup.attached is not None:
-                events.append(FeedbackEvent(float(d.time), "release", mv, cup.attached, 0, 0.0))
+                # Feedback as last read, i.e. just before the suction is switched off.
+                _, digin, ain0 = trace[-1]
+                events.append(FeedbackEvent(float(d.time), "release", mv, cup.attached, int(digin), ain0))
             cup.command(want)
         cup.update()
         if k == drop_k:
@@ -923,12 +933,11 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
                 lost = cup.lose_block()
                 drop_time = float(d.time)
                 events.append(FeedbackEvent(drop_time, "drop_injected", mv, -1 if lost is None else lost, 0, 0.0))
-            step_cycle(ctrl[k], split_after=1, on_split=inject)
+            fb = step_cycle(ctrl[k], split_after=1, on_split=inject)
         else:
-            step_cycle(ctrl[k])
+            fb = step_cycle(ctrl[k])
         err = float(np.max(np.abs(d.qpos[scene.arm_qadr] - tr.q[k])))
         max_err = max(max_err, err)
-        fb = cup.feedback()
         if prev_phase == Phase.RELEASE_DWELL and phase != Phase.RELEASE_DWELL:
             moves_completed += 1
         dwell_end = phase == Phase.GRASP_DWELL and (k == n - 1 or int(tr.phase[k + 1]) != Phase.GRASP_DWELL)
@@ -1013,7 +1022,7 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
         final_blocks=tuple(final), suction_on_at_end=cup.on, at_home_at_end=at_home, sim_time_s=float(d.time),
         wall_time_s=wall, max_tracking_error_rad=max_err, feedback_events=tuple(events), fault_move=mv,
         fault_block=block, fault_tower=fault_tower, detection_latency_s=latency,
-        warnings=warning_counts(d),
+        warnings=warning_counts(d), feedback_trace=np.array(trace, dtype=float).reshape(-1, 3),
     )
 
 
@@ -1221,13 +1230,8 @@ def simple_plan(station: Station, start: int, end: int, n_blocks: int, config: P
 
 
 def make_plan(station: Station, start: int, end: int, n_blocks: int, config: PlanConfig | None = None) -> Plan:
-    """The planner's plan (:func:`ur3hanoi.plan.plan_solve`), or :func:`simple_plan` until it exists."""
-    cfg = config if config is not None else PlanConfig()
-    try:
-        from ur3hanoi.plan import plan_solve  # type: ignore[attr-defined]
-    except ImportError:
-        return simple_plan(station, start, end, n_blocks, cfg)
-    return plan_solve(station, start, end, n_blocks, cfg)
+    """The planner's plan (:func:`ur3hanoi.plan.plan_solve`) for a solve."""
+    return plan_solve(station, start, end, n_blocks, config if config is not None else PlanConfig())
 
 
 @dataclass(frozen=True)
