@@ -6,7 +6,7 @@ VENV ?= .venv
 STAMP := $(VENV)/.installed
 export MUJOCO_GL ?= egl
 
-.PHONY: solve test venv lint bench tables clean
+.PHONY: solve test venv lint bench tables docs clean
 
 $(STAMP): pyproject.toml requirements.lock
 	bash tools/ensure-system-deps.sh
@@ -27,6 +27,9 @@ test: $(STAMP)
 tables: $(STAMP)
 	$(VENV)/bin/ur3hanoi tables robots/stations/lab_sim.yaml --key sim_pos -o tables/lab2_data.yaml
 	$(VENV)/bin/ur3hanoi tables robots/stations/lab_real.yaml --key real_pos -o tables/lab2_data.yaml
+
+docs: $(STAMP)
+	$(VENV)/bin/python tools/update_readme_cli.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .

@@ -101,3 +101,13 @@ def test_console_script_entry_point() -> None:
     out = subprocess.run([sys.executable, "-m", "ur3hanoi.cli", "--version"], capture_output=True, text=True,
                          check=True)
     assert out.stdout.startswith("ur3hanoi ")
+
+
+def test_readme_cli_reference_is_up_to_date() -> None:
+    sys.path.insert(0, str(REPO / "tools"))
+    try:
+        from update_readme_cli import render
+    finally:
+        sys.path.pop(0)
+    readme = (REPO / "README.md").read_text()
+    assert render(readme) == readme, "README CLI reference is stale: run `make docs`"

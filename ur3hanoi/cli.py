@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -346,7 +347,7 @@ def _run_plan(args: argparse.Namespace) -> int:
 
 # ------------------------------------------------------------------------------------------------------- main
 
-_COMMANDS = [_add_tables, _add_check_table, _add_calibrate, _add_solve, _add_plan]
+_COMMANDS = [_add_tables, _add_check_table, _add_calibrate, _add_plan, _add_solve]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -356,6 +357,24 @@ def build_parser() -> argparse.ArgumentParser:
     for add in _COMMANDS:
         add(sub)
     return parser
+
+
+def help_markdown(width: int = 100) -> str:
+    """The README's CLI reference: ``--help`` of the command and of every subcommand, at a fixed width."""
+    old = os.environ.get("COLUMNS")
+    os.environ["COLUMNS"] = str(width)  # argparse wraps to the terminal width: pin it for a stable text
+    try:
+        parser = build_parser()
+        parts = ["```text", "$ ur3hanoi --help", parser.format_help().rstrip(), "```"]
+        sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+        for name, p in sub.choices.items():
+            parts += ["", f"#### `ur3hanoi {name}`", "", "```text", p.format_help().rstrip(), "```"]
+    finally:
+        if old is None:
+            del os.environ["COLUMNS"]
+        else:
+            os.environ["COLUMNS"] = old
+    return "\n".join(parts) + "\n"
 
 
 def main(argv: Sequence[str] | None = None) -> int:
