@@ -159,7 +159,8 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
                                    "--start/--end it prompts on a terminal like the lab program.")
     p.add_argument("--start", type=int, metavar="S", help="start tower (1-based)")
     p.add_argument("--end", type=int, metavar="E", help="destination tower (1-based)")
-    p.add_argument("--blocks", type=int, default=3, metavar="N", help="number of blocks (default 3)")
+    p.add_argument("--blocks", type=int, default=None, metavar="N",
+                   help="number of blocks (default: the grid's heights, 3 on the lab)")
     p.add_argument("--calibration", default=None, metavar="CAL",
                    help=f"station calibration YAML (default {DEFAULT_CALIBRATION})")
     p.add_argument("--remove-block", type=int, metavar="H",
@@ -178,7 +179,7 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_run_solve)
 
 
-def _solve_calibration_path(arg: str | None) -> Path:
+def _calibration_path(arg: str | None) -> Path:
     """``--calibration``, or the default resolved against the repository when the cwd lacks it."""
     if arg is not None:
         return Path(arg)
@@ -212,13 +213,13 @@ def _solve_progress(fraction: float, label: str) -> None:
 
 def _run_solve(args: argparse.Namespace) -> int:
     import json
-    import os
 
     from ur3hanoi.hanoi import validate_instance
     from ur3hanoi.station import load_station
 
-    station = load_station(_solve_calibration_path(args.calibration))
+    station = load_station(_calibration_path(args.calibration))
     n_towers = station.n_towers
+    n_blocks = station.n_heights if args.blocks is None else args.blocks
     if args.start is None or args.end is None:
         if not sys.stdin.isatty():
             raise Ur3HanoiError("--start and --end are required when stdin is not a terminal "
@@ -227,12 +228,12 @@ def _run_solve(args: argparse.Namespace) -> int:
         end = args.end - 1 if args.end is not None else _solve_prompt_tower("end", n_towers, exclude=start)
     else:
         start, end = args.start - 1, args.end - 1
-    validate_instance(args.blocks, start, end, n_towers, station.n_heights)
+    validate_instance(n_blocks, start, end, n_towers, station.n_heights)
     if not args.speed <= 1.0:
         raise Ur3HanoiError(f"--speed {args.speed} is invalid: expected 0 < F <= 1")
-    n_moves = 2**args.blocks - 1
-    if args.remove_block is not None and not 1 <= args.remove_block <= args.blocks:
-        raise Ur3HanoiError(f"--remove-block {args.remove_block} is invalid: expected a height 1..{args.blocks}")
+    n_moves = 2**n_blocks - 1
+    if args.remove_block is not None and not 1 <= args.remove_block <= n_blocks:
+        raise Ur3HanoiError(f"--remove-block {args.remove_block} is invalid: expected a height 1..{n_blocks}")
     if args.drop_during_move is not None and not 1 <= args.drop_during_move <= n_moves:
         raise Ur3HanoiError(f"--drop-during-move {args.drop_during_move} is invalid: expected a move 1..{n_moves}")
     if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
@@ -257,8 +258,8 @@ def _run_solve(args: argparse.Namespace) -> int:
         drop_during_move=None if args.drop_during_move is None else args.drop_during_move - 1,
     )
     config = SimConfig(seed=args.seed)
-    plan = make_plan(station, start, end, args.blocks, PlanConfig(speed=args.speed))
-    scene = build_task_scene(station, start, args.blocks, faults.remove_block, config.scene)
+    plan = make_plan(station, start, end, n_blocks, PlanConfig(speed=args.speed))
+    scene = build_task_scene(station, start, n_blocks, faults.remove_block, config.scene)
     sink: object | None = None
     try:
         if args.view:
@@ -304,7 +305,8 @@ def _add_plan(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--start", type=int, required=True, help="start tower (1-based)")
     p.add_argument("--end", type=int, required=True, help="end tower (1-based)")
     p.add_argument("--blocks", type=int, default=None, help="number of blocks (default: the grid's heights)")
-    p.add_argument("--calibration", default=DEFAULT_CALIBRATION, help=f"station YAML (default {DEFAULT_CALIBRATION})")
+    p.add_argument("--calibration", default=None, metavar="CAL",
+                   help=f"station calibration YAML (default {DEFAULT_CALIBRATION})")
     p.add_argument("--speed", type=_positive_float, default=1.0,
                    help="scale of the velocity, acceleration and jerk limits, 0 < F <= 1 (default 1)")
     p.add_argument("--rate", type=_positive_float, default=125.0,
@@ -323,7 +325,7 @@ def _run_plan(args: argparse.Namespace) -> int:
     from ur3hanoi.station import load_station
     from ur3hanoi.table import atomic_write
 
-    station = load_station(args.calibration)
+    station = load_station(_calibration_path(args.calibration))
     n_blocks = station.n_heights if args.blocks is None else args.blocks
     config = PlanConfig(speed=args.speed, rate_hz=args.rate, dwell_s=args.dwell,
                         check_collisions=not args.no_collision)
