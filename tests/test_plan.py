@@ -175,3 +175,60 @@ def test_cli_json_and_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
         rows = list(csv.reader(f))
     assert rows[0] == ["t", *(f"q{i}" for i in range(1, 7)), *(f"qd{i}" for i in range(1, 7)), "suction"]
     assert {r[-1] for r in rows[1:]} == {"0", "1"}
+
+
+# ------------------------------------------------------------------------------------------------- sampling
+
+
+def test_sampling_matches_ruckig_at_time(plans: dict[tuple[str, int, int, int], Plan]) -> None:
+    """The vectorized sampler equals Ruckig's own at_time (joints) / at_time + path map (vertical legs)."""
+    plan = plans[("lab_real", 0, 2, 3)]
+    tr = plan.trajectory
+    rng = np.random.default_rng(0)
+    for k in rng.choice(len(tr.t) - 1, 300, replace=False):
+        seg = next(s for s in reversed(plan.segments) if s.t_start <= tr.t[k])
+        if seg.trajectory is None:
+            np.testing.assert_array_equal(tr.q[k], seg.q_start)
+            continue
+        x, xd, xdd = (np.array(v) for v in seg.trajectory.at_time(min(tr.t[k] - seg.t_start, seg.duration)))
+        if seg.path is not None:
+            q, d1, d2, _ = seg.path.evaluate(x[0])
+            x, xd, xdd = q, d1 * xd[0], d2 * xd[0] ** 2 + d1 * xdd[0]
+        np.testing.assert_allclose(tr.q[k], x, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(tr.qd[k], xd, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(tr.qdd[k], xdd, rtol=0, atol=1e-11)
+
+
+def test_sampling_brake_profile_fallback() -> None:
+    """A start above the velocity limit gives Ruckig a brake pre-profile; sampling still equals at_time."""
+    from ruckig import InputParameter, Ruckig
+    from ruckig import Trajectory as RuckigTrajectory
+
+    from ur3hanoi.plan import Segment, sample
+
+    inp = InputParameter(6)
+    inp.current_position, inp.target_position = [0.0] * 6, [0.5, -0.3, 0.2, 0.1, 0.0, -0.4]
+    inp.current_velocity = [1.5, 0.0, 0.0, 0.0, 0.0, 0.0]  # above max_velocity: brake first
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [1.0] * 6, [2.0] * 6, [10.0] * 6
+    traj = RuckigTrajectory(6)
+    Ruckig(6).calculate(inp, traj)
+    assert traj.profiles[0][0].brake.duration > 0
+    z = np.zeros(6)
+    seg = Segment(Phase.TRANSIT, 0, 0.0, traj.duration, z, np.array(inp.target_position), z, z, "x", traj)
+    tr = sample([seg], 125.0)
+    for k in range(len(tr.t) - 1):
+        x, xd, xdd = (np.array(v) for v in traj.at_time(tr.t[k]))
+        np.testing.assert_array_equal(tr.q[k], x)
+        np.testing.assert_array_equal(tr.qd[k], xd)
+        np.testing.assert_array_equal(tr.qdd[k], xdd)
+
+
+def test_batched_fk_matches_pinocchio(stations: dict[str, Station]) -> None:
+    from ur3hanoi.plan import _tcp_positions_world
+    from ur3hanoi.robot import load_ur3
+
+    st_ = stations["lab_real"]
+    robot = load_ur3(st_.tool, st_.limits)
+    q = np.random.default_rng(1).uniform(-3.0, 3.0, (50, 6))
+    expected = np.array([(st_.T_world_base * robot.fk(qi, "tcp")).translation for qi in q])
+    np.testing.assert_allclose(_tcp_positions_world(st_, q), expected, rtol=0, atol=1e-10)

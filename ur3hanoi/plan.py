@@ -57,7 +57,7 @@ from ur3hanoi.errors import PlanError
 from ur3hanoi.grid import ABOVE, ON, T_base_tcp, T_world_tcp, block_center_world, table_z
 from ur3hanoi.hanoi import Move, check_sequence, solve_hanoi, stacks_before_moves
 from ur3hanoi.ik import analytic_ik, branch_of, nearest_equivalent
-from ur3hanoi.robot import N_JOINTS, T_BASELINK_BASE, Ur3Model, load_ur3
+from ur3hanoi.robot import N_JOINTS, T_BASELINK_BASE, Ur3Model, dh_fk, load_ur3
 from ur3hanoi.station import Station
 from ur3hanoi.table import generate_table
 
@@ -327,6 +327,20 @@ class VerticalPath:
         dddq = (1 - u) * self.dddq[k] + u * self.dddq[k + 1]
         return q, dq, ddq, dddq
 
+    def evaluate_many(self, s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """:meth:`evaluate` at every ``s`` (N,) [m] at once: four (N, 6) arrays, with the same arithmetic."""
+        s = np.minimum(np.maximum(s, 0.0), self.length_m)
+        k = np.minimum(np.searchsorted(self.s, s, side="right") - 1, len(self.s) - 2)
+        h = (self.s[k + 1] - self.s[k])[:, None]
+        u = (s[:, None] - self.s[k][:, None]) / h
+        q0, q1, m0, m1 = self.q[k], self.q[k + 1], self.dq[k] * h, self.dq[k + 1] * h
+        u2, u3 = u * u, u * u * u
+        q = (2 * u3 - 3 * u2 + 1) * q0 + (u3 - 2 * u2 + u) * m0 + (-2 * u3 + 3 * u2) * q1 + (u3 - u2) * m1
+        dq = ((6 * u2 - 6 * u) * q0 + (3 * u2 - 4 * u + 1) * m0 + (-6 * u2 + 6 * u) * q1 + (3 * u2 - 2 * u) * m1) / h
+        ddq = (1 - u) * self.ddq[k] + u * self.ddq[k + 1]
+        dddq = (1 - u) * self.dddq[k] + u * self.dddq[k + 1]
+        return q, dq, ddq, dddq
+
 
 @dataclass(frozen=True)
 class Waypoints:
@@ -396,6 +410,10 @@ def build_waypoints(station: Station, node_step_m: float = 0.002) -> Waypoints:
 # -------------------------------------------------------------------------------------------------- ruckig
 
 
+def _aslist(x: FloatArray | list[float]) -> list[float]:
+    return x.tolist() if isinstance(x, np.ndarray) else x
+
+
 class _Ruckig:
     """One offline Ruckig instance with the given limits; counts its own time for the benchmark."""
 
@@ -409,17 +427,21 @@ class _Ruckig:
         self.seconds = 0.0
         self.calls = 0
 
-    def calc(self, q0: FloatArray, v0: FloatArray, a0: FloatArray, q1: FloatArray, v1: FloatArray,
-             a1: FloatArray) -> RuckigTrajectory | None:
-        """Time-optimal (time-synchronized) segment between two states; None if Ruckig fails."""
+    def calc(self, q0: FloatArray | list[float], v0: FloatArray | list[float], a0: FloatArray | list[float],
+             q1: FloatArray | list[float], v1: FloatArray | list[float],
+             a1: FloatArray | list[float]) -> RuckigTrajectory | None:
+        """Time-optimal (time-synchronized) segment between two states; None if Ruckig fails.
+
+        States may be given as lists (callers that try many candidates convert them once).
+        """
         t0 = time.perf_counter()
         inp = self.inp
-        inp.current_position = q0.tolist()
-        inp.current_velocity = v0.tolist()
-        inp.current_acceleration = a0.tolist()
-        inp.target_position = q1.tolist()
-        inp.target_velocity = v1.tolist()
-        inp.target_acceleration = a1.tolist()
+        inp.current_position = _aslist(q0)
+        inp.current_velocity = _aslist(v0)
+        inp.current_acceleration = _aslist(a0)
+        inp.target_position = _aslist(q1)
+        inp.target_velocity = _aslist(v1)
+        inp.target_acceleration = _aslist(a1)
         traj = RuckigTrajectory(self.dofs)
         try:
             result = self.otg.calculate(inp, traj)
@@ -496,6 +518,12 @@ class _Builder:
         self.rk = _Ruckig(self.limits.v_max, self.limits.a_max, self.limits.j_max)
         self._legs: dict[Slot, list[_Leg]] = {}
         self._path_rk: dict[Slot, tuple[_Ruckig, PathLimits]] = {}
+        # Memos of identical Ruckig problems: a Hanoi solve revisits the same few slot pairs over and over (1023
+        # moves use at most n_towers * n_heights slots), and each problem is deterministic in its key, so reusing
+        # the trajectory object gives exactly the same segments. Shared trajectories are never mutated.
+        self._path_memo: dict[tuple[Slot, float, bool], RuckigTrajectory | None] = {}
+        self._horizontal_memo: dict[tuple[Slot | None, bytes, Slot | None, bytes],
+                                     tuple[float, float, RuckigTrajectory]] = {}
 
     @property
     def ruckig_seconds(self) -> float:
@@ -510,7 +538,16 @@ class _Builder:
         return vp, rk, pl
 
     def path_traj(self, slot: Slot, sigma: float, down: bool) -> RuckigTrajectory | None:
-        """1-DoF Ruckig of s: down = above (entering at sigma [m/s]) -> on at rest; else on -> above (leaving)."""
+        """1-DoF Ruckig of s: down = above (entering at sigma [m/s]) -> on at rest; else on -> above (leaving).
+
+        Memoized per (slot, sigma, down): :meth:`legs` already solves every candidate descend once.
+        """
+        key = (slot, sigma, down)
+        if key not in self._path_memo:
+            self._path_memo[key] = self._path_traj(slot, sigma, down)
+        return self._path_memo[key]
+
+    def _path_traj(self, slot: Slot, sigma: float, down: bool) -> RuckigTrajectory | None:
         vp, rk, _ = self._path(slot)
         z = np.zeros(1)
         L = vp.length_m
@@ -560,15 +597,27 @@ class _Builder:
 
         def horizontal(q0: FloatArray, slot0: Slot | None, q1: FloatArray,
                        slot1: Slot | None) -> tuple[float, float, RuckigTrajectory]:
-            """Best (sigma0, sigma1, traj): slot0 is left upward, slot1 entered downward (None: at rest)."""
+            """Best (sigma0, sigma1, traj): slot0 is left upward, slot1 entered downward (None: at rest).
+
+            Memoized: the key holds every input of the problem (the candidate via states follow from the slots).
+            """
+            key = (slot0, q0.tobytes(), slot1, q1.tobytes())
+            if key not in self._horizontal_memo:
+                self._horizontal_memo[key] = horizontal_uncached(q0, slot0, q1, slot1)
+            return self._horizontal_memo[key]
+
+        def horizontal_uncached(q0: FloatArray, slot0: Slot | None, q1: FloatArray,
+                                slot1: Slot | None) -> tuple[float, float, RuckigTrajectory]:
             c0 = self.legs(slot0) if slot0 is not None else [_Leg(0.0, 0.0)]
             c1 = self.legs(slot1) if slot1 is not None else [_Leg(0.0, 0.0)]
             best: tuple[float, float, float, RuckigTrajectory] | None = None
+            # Candidate states as lists once (not per Ruckig call: 36 calls per connection by default).
+            q0l, q1l = q0.tolist(), q1.tolist()
+            ends = [(l1, *(x.tolist() for x in self.via_state(slot1, l1.sigma, down=True))) for l1 in c1]
             for l0 in c0:
-                v0, a0 = self.via_state(slot0, l0.sigma, down=False)
-                for l1 in c1:
-                    v1, a1 = self.via_state(slot1, l1.sigma, down=True)
-                    traj = self.rk.calc(q0, v0, a0, q1, v1, a1)
+                v0, a0 = (x.tolist() for x in self.via_state(slot0, l0.sigma, down=False))
+                for l1, v1, a1 in ends:
+                    traj = self.rk.calc(q0l, v0, a0, q1l, v1, a1)
                     if traj is None:
                         continue  # fall back to the next (smaller) via speed
                     cost = l0.duration + traj.duration + l1.duration
@@ -621,6 +670,93 @@ class _Builder:
 
 
 # ------------------------------------------------------------------------------------------------- sampling
+#
+# Sampling is vectorized over all samples of the plan at once (a per-sample Python loop over ``at_time`` cost
+# ~25 ms per move). It reproduces Ruckig's ``Trajectory.at_time`` arithmetic: each DoF's profile is 7 constant-jerk
+# phases (``Profile.t`` durations; ``p``, ``v``, ``a`` at each phase start, and after the end), the phase is found by
+# upper_bound on the cumulative times ``t_sum`` and the state integrated from its start with ``ruckig::integrate``.
+# Segments whose profiles carry a brake pre-profile (only for starts outside the limits, which the planner never
+# produces) take the per-sample ``at_time`` path instead.
+
+_N_PIECES = 8  # pieces of a profile: 7 constant-jerk phases and the state after the end
+# Samples per block of the elementwise evaluation. Arrays are joint-major (6, N), so broadcasting a per-sample (N,)
+# operand runs numpy's inner loop over samples rather than over 6 joints; and blocks of 4096 keep every temporary
+# (~200 kB) in cache and out of fresh-page allocation, ~3x faster than whole-plan temporaries.
+_CHUNK = 4096
+
+
+def _lexi_keys(group: npt.NDArray[np.intp], x: FloatArray) -> npt.NDArray[np.complex128]:
+    """Keys that sort by (group, x) lexicographically: numpy orders complex numbers by real, then imaginary part.
+
+    Used to run one exact ``searchsorted`` over many independently sorted runs (one run per group) at once.
+    """
+    return group.astype(float) + 1j * x
+
+
+@dataclass(frozen=True)
+class _ProfileTable:
+    """Ruckig profiles of several trajectories, stacked as (trajectory row, DoF, piece) for vectorized evaluation.
+
+    ``t_sum`` (R, D, 7): cumulative phase times (sequential sums, as Ruckig's own ``t_sum``, so the phase lookup
+    matches it bit for bit); ``t0`` (R, D, 8): start time of each piece (0, then ``t_sum``); ``p, v, a, j``
+    (R, D, 8): the state and jerk at each piece start. Piece 7 is "after the profile end" (constant acceleration,
+    zero jerk), which Ruckig uses for a DoF that finishes early and at ``t = duration``.
+    """
+
+    t_sum: FloatArray
+    t0: FloatArray
+    p: FloatArray
+    v: FloatArray
+    a: FloatArray
+    j: FloatArray
+
+    @classmethod
+    def of(cls, profiles: Sequence[Sequence[Any]]) -> _ProfileTable:
+        """From ``profiles[r][d]`` (ruckig.Profile without brake), read once through the bindings as lists."""
+        t = np.array([[prof.t for prof in row] for row in profiles], dtype=float).reshape(len(profiles), -1, 7)
+        t_sum = np.cumsum(t, axis=2)  # add.accumulate: sequential, like Ruckig (not pairwise like np.sum)
+        shape = (*t_sum.shape[:2], _N_PIECES)
+        t0 = np.zeros(shape)
+        t0[:, :, 1:] = t_sum
+        p, v, a = (np.array([[getattr(prof, name) for prof in row] for row in profiles], dtype=float).reshape(shape)
+                   for name in ("p", "v", "a"))
+        j = np.zeros(shape)
+        j[:, :, :7] = np.array([[prof.j for prof in row] for row in profiles], dtype=float).reshape((*shape[:2], 7))
+        return cls(t_sum, t0, p, v, a, j)
+
+    def evaluate(self, seg: npt.NDArray[np.intp], row_of_seg: npt.NDArray[np.intp], tau: FloatArray
+                 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """(position, velocity, acceleration, jerk), each (D, N) (DoF-major), at local times ``tau`` (N,).
+
+        ``seg`` (N,) is the sample's segment index, non-decreasing, with ``tau`` non-decreasing within a segment;
+        ``row_of_seg`` maps a segment index to its table row (-1: not evaluated here).
+        """
+        D = self.p.shape[1]
+        n = len(tau)
+        segs = np.flatnonzero(row_of_seg >= 0)  # every segment of this table, sampled or not
+        rows = row_of_seg[segs]
+        # Phase lookup for all samples and DoFs: first sample at or after each (segment, phase end) by one
+        # searchsorted on (segment, tau) keys; a sample's phase index is then the number of its segment's phase ends
+        # at or before it (upper_bound, as Ruckig), i.e. a running count minus the 7 ends of every earlier segment.
+        pos = np.searchsorted(_lexi_keys(seg, tau), _lexi_keys(np.repeat(segs, D * 7), self.t_sum[rows].ravel()),
+                              side="left")
+        lane = np.tile(np.repeat(np.arange(D), 7), len(segs))
+        marks = np.bincount(lane * (n + 1) + pos, minlength=D * (n + 1)).reshape(D, n + 1)
+        earlier = np.cumsum(row_of_seg >= 0) - 1  # rank of each segment among this table's segments
+        piece = np.cumsum(marks[:, :n], axis=1) - 7 * earlier[seg]
+        flat = (row_of_seg[seg] * D + np.arange(D)[:, None]) * _N_PIECES + piece
+        out = np.empty((4, D, n))
+        t0, p, v, a, j = (x.ravel() for x in (self.t0, self.p, self.v, self.a, self.j))
+        for c in range(0, n, _CHUNK):
+            f, tc = flat[:, c:c + _CHUNK], tau[c:c + _CHUNK]
+            dt = tc - t0.take(f)  # ndarray.take: a faster gather than fancy indexing
+            p0, v0, a0, jj = p.take(f), v.take(f), a.take(f), j.take(f)
+            # ruckig::integrate, same operation order.
+            out[0, :, c:c + _CHUNK] = p0 + dt * (v0 + dt * (a0 / 2 + dt * jj / 6))
+            out[1, :, c:c + _CHUNK] = v0 + dt * (a0 + dt * jj / 2)
+            out[2, :, c:c + _CHUNK] = a0 + dt * jj
+            out[3, :, c:c + _CHUNK] = jj
+        return out[0], out[1], out[2], out[3]
 
 
 def _profile_jerk(traj: RuckigTrajectory, tau: FloatArray) -> FloatArray:
@@ -633,7 +769,7 @@ def _profile_jerk(traj: RuckigTrajectory, tau: FloatArray) -> FloatArray:
         idx = np.searchsorted(t_bounds, tau, side="right")
         jerks = np.append(np.asarray(prof.j, dtype=float), 0.0)  # after the end: constant velocity
         out[:, i] = jerks[np.minimum(idx, 7)]
-        if tb > 0.0:  # a brake pre-profile (never for in-limit starts; handled for completeness)
+        if tb > 0.0:  # a brake pre-profile
             bb = np.cumsum(prof.brake.t)
             in_brake = tau < tb
             bidx = np.minimum(np.searchsorted(bb, tau[in_brake], side="right"), 1)
@@ -641,51 +777,132 @@ def _profile_jerk(traj: RuckigTrajectory, tau: FloatArray) -> FloatArray:
     return out
 
 
+def _at_times(traj: RuckigTrajectory, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Per-sample ``at_time`` (the fallback for profiles with a brake pre-profile): four (N, dofs) arrays."""
+    states = np.array([traj.at_time(float(tt)) for tt in tau], dtype=float).reshape(len(tau), 3, -1)
+    return states[:, 0], states[:, 1], states[:, 2], _profile_jerk(traj, tau)
+
+
+class _StackedPaths:
+    """The nodes of several :class:`VerticalPath` stacked (joint-major), to evaluate many paths in one call."""
+
+    def __init__(self, paths: Sequence[VerticalPath]) -> None:
+        self.sizes = np.array([len(vp.s) for vp in paths])
+        self.first = np.cumsum(self.sizes) - self.sizes  # index of each path's first node
+        self.s = np.concatenate([vp.s for vp in paths])
+        self.q, self.dq, self.ddq, self.dddq = (np.concatenate([getattr(vp, name) for vp in paths]).T.copy()
+                                                for name in ("q", "dq", "ddq", "dddq"))
+        self.length = np.array([vp.length_m for vp in paths])
+        self.node_keys = _lexi_keys(np.repeat(np.arange(len(paths)), self.sizes), self.s)
+
+    def evaluate(self, which: npt.NDArray[np.intp], s: FloatArray
+                 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """:meth:`VerticalPath.evaluate` of path ``which[i]`` at ``s[i]`` (same arithmetic): four (6, N) arrays.
+
+        One searchsorted on (path, s) keys finds each sample's node interval in its own path.
+        """
+        S = self.s
+        s = np.minimum(np.maximum(s, 0.0), self.length[which])
+        k = np.minimum(np.searchsorted(self.node_keys, _lexi_keys(which, s), side="right") - 1,
+                       self.first[which] + self.sizes[which] - 2)
+        k1 = k + 1
+        h = S.take(k1) - S.take(k)
+        u = (s - S.take(k)) / h
+        # ndarray.take(axis=1): ~2x faster than fancy indexing [:, k] for these gathers.
+        q0, q1, m0, m1 = self.q.take(k, 1), self.q.take(k1, 1), self.dq.take(k, 1) * h, self.dq.take(k1, 1) * h
+        u2, u3 = u * u, u * u * u
+        q = (2 * u3 - 3 * u2 + 1) * q0 + (u3 - 2 * u2 + u) * m0 + (-2 * u3 + 3 * u2) * q1 + (u3 - u2) * m1
+        dq = ((6 * u2 - 6 * u) * q0 + (3 * u2 - 4 * u + 1) * m0 + (-6 * u2 + 6 * u) * q1 + (3 * u2 - 2 * u) * m1) / h
+        ddq = (1 - u) * self.ddq.take(k, 1) + u * self.ddq.take(k1, 1)
+        dddq = (1 - u) * self.dddq.take(k, 1) + u * self.dddq.take(k1, 1)
+        return q, dq, ddq, dddq
+
+
 def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
     """Uniform samples ``t = i / rate_hz`` of the chained segments, with suction, move index and phase.
 
-    Joint segments: q, qd, qdd from Ruckig's ``at_time``, qddd from its profiles. Vertical legs: s, sd, sdd from
-    ``at_time`` of the path trajectory, sddd from its profile, mapped to joints by the chain rule.
+    Joint segments: q, qd, qdd, qddd from the Ruckig profiles. Vertical legs: s, sd, sdd, sddd from the path
+    trajectory's profile, mapped to joints by the chain rule. Both are evaluated for all samples at once (see the
+    section comment); the per-segment Python work is reading each distinct Ruckig trajectory's profiles once.
     """
     duration = segments[-1].t_end
     n = math.ceil(duration * rate_hz - 1e-9) + 1
     t = np.arange(n) / rate_hz
-    q = np.empty((n, N_JOINTS))
-    qd = np.zeros((n, N_JOINTS))
-    qdd = np.zeros((n, N_JOINTS))
-    qddd = np.zeros((n, N_JOINTS))
-    phase = np.empty(n, dtype=int)
-    mi = np.empty(n, dtype=int)
+    n_seg = len(segments)
     starts = np.array([s.t_start for s in segments])
-    seg_of = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(segments) - 1)
-    bounds = np.searchsorted(seg_of, np.arange(len(segments) + 1))
+    durations = np.array([s.duration for s in segments])
+    seg_of = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, n_seg - 1)
+    tau = np.minimum(t - starts[seg_of], durations[seg_of])
+    phase = np.array([int(s.phase) for s in segments], dtype=int)[seg_of]
+    mi = np.array([s.move_index for s in segments], dtype=int)[seg_of]
+
+    # Table rows per segment (-1: none). The builder reuses one Ruckig trajectory for repeated legs, so each
+    # distinct trajectory (by identity) is read from the bindings once.
+    rows: tuple[dict[int, int], dict[int, int]] = ({}, {})  # joint, path: id(trajectory) -> row
+    profiles: tuple[list[Any], list[Any]] = ([], [])
+    row_of_seg = np.full((2, n_seg), -1, dtype=np.intp)
+    path_rows: dict[int, int] = {}
+    path_list: list[VerticalPath] = []
+    path_of_seg = np.zeros(n_seg, dtype=np.intp)
+    dwell_q = np.zeros((N_JOINTS, n_seg))
+    slow: list[int] = []  # segments with a brake pre-profile: per-sample at_time
     for k, seg in enumerate(segments):
-        i0, i1 = bounds[k], bounds[k + 1]
-        if i0 == i1:
+        traj = seg.trajectory
+        if traj is None:
+            dwell_q[:, k] = seg.q_start
             continue
-        phase[i0:i1] = int(seg.phase)
-        mi[i0:i1] = seg.move_index
-        if seg.trajectory is None:
-            q[i0:i1] = seg.q_start
-            continue
-        tau = np.minimum(t[i0:i1] - seg.t_start, seg.duration)
-        jerk = _profile_jerk(seg.trajectory, tau)
+        kind = 0 if seg.path is None else 1
+        r = rows[kind].get(id(traj))
+        if r is None:
+            profs = traj.profiles[0]
+            if any(prof.brake.duration > 0.0 for prof in profs):
+                slow.append(k)
+                continue
+            r = rows[kind][id(traj)] = len(profiles[kind])
+            profiles[kind].append(profs)
+        row_of_seg[kind, k] = r
+        if seg.path is not None:
+            path_of_seg[k] = path_rows.setdefault(id(seg.path), len(path_list))
+            if path_of_seg[k] == len(path_list):
+                path_list.append(seg.path)
+
+    # Joint-major (6, N) work arrays (see _ProfileTable.evaluate), transposed to the contract's (N, 6) at the end.
+    q = dwell_q[:, seg_of]  # the dwells' rest pose; moving samples are overwritten below
+    qd, qdd, qddd = np.zeros((N_JOINTS, n)), np.zeros((N_JOINTS, n)), np.zeros((N_JOINTS, n))
+    idx = np.flatnonzero(row_of_seg[0, seg_of] >= 0)
+    if idx.size:
+        q[:, idx], qd[:, idx], qdd[:, idx], qddd[:, idx] = _ProfileTable.of(profiles[0]).evaluate(
+            seg_of[idx], row_of_seg[0], tau[idx])
+    idx = np.flatnonzero(row_of_seg[1, seg_of] >= 0)
+    if idx.size:
+        s_all = _ProfileTable.of(profiles[1]).evaluate(seg_of[idx], row_of_seg[1], tau[idx])
+        stacked = _StackedPaths(path_list)
+        which = path_of_seg[seg_of[idx]]
+        for c in range(0, len(idx), _CHUNK):
+            ii, cc = idx[c:c + _CHUNK], slice(c, c + _CHUNK)
+            s, sd, sdd, sddd = (x[0, cc] for x in s_all)
+            q[:, ii], d1, d2, d3 = stacked.evaluate(which[cc], s)
+            qd[:, ii] = d1 * sd
+            qdd[:, ii] = d2 * sd * sd + d1 * sdd
+            qddd[:, ii] = d3 * sd**3 + 3 * d2 * sd * sdd + d1 * sddd
+    for k in slow:
+        seg = segments[k]
+        assert seg.trajectory is not None
+        i0, i1 = np.searchsorted(seg_of, [k, k + 1])
+        x, xd, xdd, xddd = _at_times(seg.trajectory, tau[i0:i1])
         if seg.path is None:
-            for i, tt in enumerate(tau, start=i0):
-                q[i], qd[i], qdd[i] = seg.trajectory.at_time(float(tt))
-            qddd[i0:i1] = jerk
+            q[:, i0:i1], qd[:, i0:i1], qdd[:, i0:i1], qddd[:, i0:i1] = x.T, xd.T, xdd.T, xddd.T
         else:
-            for i, tt in enumerate(tau, start=i0):
-                (s,), (sd,), (sdd,) = seg.trajectory.at_time(float(tt))
-                sddd = jerk[i - i0, 0]
-                q[i], d1, d2, d3 = seg.path.evaluate(s)
-                qd[i] = d1 * sd
-                qdd[i] = d2 * sd * sd + d1 * sdd
-                qddd[i] = d3 * sd**3 + 3 * d2 * sd * sdd + d1 * sddd
+            x, xd, xdd, xddd = x[:, 0], xd[:, 0], xdd[:, 0], xddd[:, 0]
+            q[:, i0:i1], d1, d2, d3 = (y.T for y in seg.path.evaluate_many(x))
+            qd[:, i0:i1] = d1 * xd
+            qdd[:, i0:i1] = d2 * xd * xd + d1 * xdd
+            qddd[:, i0:i1] = d3 * xd**3 + 3 * d2 * xd * xdd + d1 * xddd
     # Samples after the end (the last one) hold the final state at rest.
     last = t > duration
-    qd[last], qdd[last], qddd[last] = 0.0, 0.0, 0.0
+    qd[:, last], qdd[:, last], qddd[:, last] = 0.0, 0.0, 0.0
     suction = np.isin(phase, [int(p) for p in SUCTION_PHASES])
+    q, qd, qdd, qddd = (np.ascontiguousarray(x.T) for x in (q, qd, qdd, qddd))
     return Trajectory(rate_hz=float(rate_hz), t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, suction=suction,
                       move_index=mi, phase=phase)
 
@@ -725,30 +942,44 @@ def check_limits(tr: Trajectory, segments: Sequence[Segment], limits: KinematicL
     return out
 
 
+def _tcp_positions_world(station: Station, q: FloatArray) -> FloatArray:
+    """World position [m] of the suction point at every row of ``q`` (N, 6): batched UR3 DH forward kinematics.
+
+    Same kinematics as ``Ur3Model.fk(q, "tcp")`` (the URDF and the DH table agree to ~1e-11 m), without a
+    per-sample Pinocchio call.
+    """
+    T = dh_fk(q)
+    t_flange_tcp = load_ur3(station.tool, station.limits).T_flange_tcp("tool0").translation
+    p_base = T[:, :3, :3] @ t_flange_tcp + T[:, :3, 3]
+    T_wb = station.T_world_base
+    return p_base @ T_wb.rotation.T + T_wb.translation
+
+
 def check_vertical(tr: Trajectory, moves: Sequence[Move], station: Station, tol_m: float) -> tuple[list[str], float]:
     """FK at every sample of the vertical phases: suction point within ``tol_m`` of the block's vertical line.
 
     Returns (violations, worst deviation [m]).
     """
-    robot = load_ur3(station.tool, station.limits)
-    T_wb = station.T_world_base
     out: list[str] = []
-    worst = 0.0
-    vert = np.isin(tr.phase, [int(p) for p in VERTICAL_PHASES])
-    for k in np.flatnonzero(vert):
-        m = moves[tr.move_index[k]]
-        ph = Phase(tr.phase[k])
-        tower, height = ((m.from_tower, m.from_height) if ph in (Phase.DESCEND_PICK, Phase.LIFT)
-                         else (m.to_tower, m.to_height))
-        line = T_world_tcp(station, tower, height, ON).translation
-        p = (T_wb * robot.fk(tr.q[k], "tcp")).translation
-        dev = float(np.linalg.norm(p[:2] - line[:2]))
-        worst = max(worst, dev)
-        if dev > tol_m and len(out) < 5:
-            out.append(f"suction point {dev * 1e3:.2f} mm off the vertical line of tower {tower + 1} height "
-                       f"{height + 1} at t = {tr.t[k]:.3f} s ({ph.name}, move {tr.move_index[k] + 1}); "
-                       f"allowed {tol_m * 1e3:.1f} mm")
-    return out, worst
+    vert = np.flatnonzero(np.isin(tr.phase, [int(p) for p in VERTICAL_PHASES]))
+    if vert.size == 0:
+        return out, 0.0
+    # The slot of every vertical sample: the move's source while picking/lifting, else its destination.
+    src = np.array([(m.from_tower, m.from_height) for m in moves], dtype=int).reshape(-1, 2)
+    dst = np.array([(m.to_tower, m.to_height) for m in moves], dtype=int).reshape(-1, 2)
+    mi = tr.move_index[vert]
+    at_src = np.isin(tr.phase[vert], [int(Phase.DESCEND_PICK), int(Phase.LIFT)])
+    slot = np.where(at_src[:, None], src[mi], dst[mi])
+    line_xy = np.array([[T_world_tcp(station, t, h, ON).translation[:2] for h in range(station.n_heights)]
+                        for t in range(station.n_towers)]).reshape(station.n_towers, station.n_heights, 2)
+    p = _tcp_positions_world(station, tr.q[vert])
+    dev = np.linalg.norm(p[:, :2] - line_xy[slot[:, 0], slot[:, 1]], axis=1)
+    for i in np.flatnonzero(dev > tol_m)[:5]:
+        k, (tower, height) = vert[i], slot[i]
+        out.append(f"suction point {dev[i] * 1e3:.2f} mm off the vertical line of tower {tower + 1} height "
+                   f"{height + 1} at t = {tr.t[k]:.3f} s ({Phase(int(tr.phase[k])).name}, move "
+                   f"{tr.move_index[k] + 1}); allowed {tol_m * 1e3:.1f} mm")
+    return out, float(np.max(dev))
 
 
 class CollisionScene:

@@ -169,19 +169,24 @@ def urdf_text(tool: ToolOffset | None = None, absolute_meshes: bool = True) -> s
 
 
 def dh_fk(q: FloatArray) -> FloatArray:
-    """UR3 forward kinematics from the DH table: the 4x4 pose of the flange (``tool0``) in ``base``."""
-    T = np.eye(4)
-    for qi, d, a, alpha in zip(np.asarray(q, dtype=float), DH_D, DH_A, DH_ALPHA, strict=True):
-        ct, st, ca, sa = math.cos(qi), math.sin(qi), math.cos(alpha), math.sin(alpha)
-        T = T @ np.array(
-            [
-                [ct, -st * ca, st * sa, a * ct],
-                [st, ct * ca, -ct * sa, a * st],
-                [0.0, sa, ca, d],
-                [0.0, 0.0, 0.0, 1.0],
-            ]
-        )
-    return T
+    """UR3 forward kinematics from the DH table: the pose of the flange (``tool0``) in ``base``.
+
+    ``q`` [rad] of shape (6,) gives a 4x4 matrix; shape (N, 6) gives (N, 4, 4) (batched, for checks over whole
+    trajectories without a per-sample Pinocchio call).
+    """
+    q = np.asarray(q, dtype=float)
+    qs = q.reshape(-1, N_JOINTS)
+    T = np.broadcast_to(np.eye(4), (len(qs), 4, 4))
+    for i in range(N_JOINTS):
+        ct, st = np.cos(qs[:, i]), np.sin(qs[:, i])
+        ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
+        A = np.zeros((len(qs), 4, 4))
+        A[:, 0, 0], A[:, 0, 1], A[:, 0, 2], A[:, 0, 3] = ct, -st * ca, st * sa, DH_A[i] * ct
+        A[:, 1, 0], A[:, 1, 1], A[:, 1, 2], A[:, 1, 3] = st, ct * ca, -ct * sa, DH_A[i] * st
+        A[:, 2, 1], A[:, 2, 2], A[:, 2, 3] = sa, ca, DH_D[i]
+        A[:, 3, 3] = 1.0
+        T = T @ A
+    return T[0] if q.ndim == 1 else T
 
 
 # Link lengths the URDF must encode [m]; a UR5 (d1 = 0.089159, a2 = 0.425) fails this check.
