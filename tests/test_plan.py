@@ -232,3 +232,29 @@ def test_batched_fk_matches_pinocchio(stations: dict[str, Station]) -> None:
     q = np.random.default_rng(1).uniform(-3.0, 3.0, (50, 6))
     expected = np.array([(st_.T_world_base * robot.fk(qi, "tcp")).translation for qi in q])
     np.testing.assert_allclose(_tcp_positions_world(st_, q), expected, rtol=0, atol=1e-10)
+
+
+def test_via_descent_finds_grid_optimum(stations: dict[str, Station]) -> None:
+    """The descent over via-speed candidates picks the optimum of the full candidate grid on every connection."""
+    from ur3hanoi.hanoi import solve_hanoi
+    from ur3hanoi.plan import _AT_REST, _Builder
+
+    for name, (s, e) in itertools.product(STATIONS, [(0, 2), (2, 1)]):
+        st_ = stations[name]
+        b = _Builder(st_, build_waypoints(st_), PlanConfig())
+        b.build(solve_hanoi(3, s, e, st_.n_towers, st_.n_heights))
+        for (slot0, q0b, slot1, q1b), (s0, s1, traj) in b._horizontal_memo.items():
+            q0, q1 = np.frombuffer(q0b), np.frombuffer(q1b)
+            c0 = b.legs(slot0) if slot0 is not None else _AT_REST
+            c1 = b.legs(slot1) if slot1 is not None else _AT_REST
+            legs0 = [c0.get(i) for i in range(c0.count())]
+            legs1 = [c1.get(j) for j in range(c1.count())]
+            chosen = next(l0.duration for l0 in legs0 if l0 and l0.sigma == s0) + traj.duration + next(
+                l1.duration for l1 in legs1 if l1 and l1.sigma == s1)
+            best = np.inf
+            for l0, l1 in itertools.product(legs0, legs1):
+                assert l0 is not None and l1 is not None
+                t = b.rk.calc(q0, *b.via_state(slot0, l0.sigma, False), q1, *b.via_state(slot1, l1.sigma, True))
+                if t is not None:
+                    best = min(best, l0.duration + t.duration + l1.duration)
+            assert chosen == pytest.approx(best, abs=1e-12)

@@ -21,8 +21,9 @@ How the motion is built (see :func:`plan_solve`):
   [m/s]. ``sigma`` is picked per transit/carry segment from ``PlanConfig.via_fractions`` of the largest speed
   that the vertical leg can brake from without overshooting the contact pose, minimising the summed duration of
   the vertical leg, the horizontal segment and the next vertical leg (the legs decouple: a via point joins
-  exactly one vertical and one horizontal segment). A candidate whose ``calculate`` fails is dropped; zero
-  (stop-and-go) is always a candidate.
+  exactly one vertical and one horizontal segment). The minimum is found by a descent over the grid of (exit,
+  entry) candidates from the fastest pair (see ``_Builder.build``). A candidate whose ``calculate`` fails is
+  dropped; zero (stop-and-go) is always a candidate.
 - Honest vertical approach: a straight joint-space line between above and on bends the suction point up to ~9 mm
   off the vertical on the lab stations, so each vertical leg is split at IK points on the vertical line
   (:func:`ur3hanoi.ik.solve_on_branch`) until every chord deviates <= ``chord_tol_m``; interior via velocities
@@ -41,10 +42,10 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from enum import IntEnum
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import Any
 
 import numpy as np
@@ -313,6 +314,13 @@ class VerticalPath:
     length_m: float
     line_xy: FloatArray
 
+    @cached_property
+    def derivative_bounds(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Per-joint ``max |d^k q / ds^k|`` over the nodes for k = 1, 2, 3 (computed once per path: the waypoints,
+        and so their paths, are cached per station while every plan derives its path limits from these)."""
+        return (np.max(np.abs(self.dq), axis=0), np.max(np.abs(self.ddq), axis=0),
+                np.max(np.abs(self.dddq), axis=0))
+
     def evaluate(self, s: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """(q, dq/ds, d2q/ds2, d3q/ds3) at ``s`` [m] (clamped to [0, length_m])."""
         s = min(max(s, 0.0), self.length_m)
@@ -487,7 +495,7 @@ class PathLimits:
 
     @classmethod
     def for_path(cls, path: VerticalPath, lim: KinematicLimits) -> PathLimits:
-        D1, D2, D3 = (1.05 * np.max(np.abs(x), axis=0) + 1e-12 for x in (path.dq, path.ddq, path.dddq))
+        D1, D2, D3 = (1.05 * x + 1e-12 for x in path.derivative_bounds)
         v = float(np.min(np.minimum.reduce([lim.v_max / D1, np.sqrt(0.4 * lim.a_max / D2),
                                             np.cbrt(0.3 * lim.j_max / D3)])))
         a = float(np.min(np.minimum((lim.a_max - D2 * v * v) / D1, 0.4 * lim.j_max / (3 * D2 * v))))
@@ -506,6 +514,37 @@ class _Leg:
 Slot = tuple[int, int]
 
 
+class _LegCandidates:
+    """A slot's candidate legs, fastest via speed first; a leg's Ruckig problem is solved on first use (the search
+    in ``_Builder.build`` usually needs only the fastest two or three). Failed candidates are dropped."""
+
+    def __init__(self, speeds: Sequence[float], solve: Callable[[float], RuckigTrajectory | None],
+                 solved: Sequence[_Leg] = ()) -> None:
+        self._speeds = iter(speeds)
+        self._solve = solve
+        self._legs: list[_Leg] = list(solved)
+
+    def get(self, i: int) -> _Leg | None:
+        """The i-th feasible candidate (None: fewer than i + 1 exist)."""
+        while len(self._legs) <= i:
+            sigma = next(self._speeds, None)
+            if sigma is None:
+                return None
+            traj = self._solve(sigma)
+            if traj is not None:
+                self._legs.append(_Leg(sigma, traj.duration))
+        return self._legs[i]
+
+    def count(self) -> int:
+        """Number of feasible candidates (solves them all)."""
+        while self.get(len(self._legs)) is not None:
+            pass
+        return len(self._legs)
+
+
+_AT_REST = _LegCandidates([], lambda _: None, [_Leg(0.0, 0.0)])  # home: at rest, no vertical leg
+
+
 class _Builder:
     """Chains Ruckig segments for a move sequence (pass-through or stop-and-go)."""
 
@@ -516,7 +555,7 @@ class _Builder:
         self.pass_through = pass_through and config.pass_through
         self.limits = config.limits(station)
         self.rk = _Ruckig(self.limits.v_max, self.limits.a_max, self.limits.j_max)
-        self._legs: dict[Slot, list[_Leg]] = {}
+        self._legs: dict[Slot, _LegCandidates] = {}
         self._path_rk: dict[Slot, tuple[_Ruckig, PathLimits]] = {}
         # Memos of identical Ruckig problems: a Hanoi solve revisits the same few slot pairs over and over (1023
         # moves use at most n_towers * n_heights slots), and each problem is deterministic in its key, so reusing
@@ -549,28 +588,21 @@ class _Builder:
 
     def _path_traj(self, slot: Slot, sigma: float, down: bool) -> RuckigTrajectory | None:
         vp, rk, _ = self._path(slot)
-        z = np.zeros(1)
+        z = [0.0]
         L = vp.length_m
-        if down:
-            traj = rk.calc(z, np.array([sigma]), z, np.array([L]), z, z)
-        else:
-            traj = rk.calc(np.array([L]), z, z, z, np.array([-sigma]), z)
+        traj = rk.calc(z, [sigma], z, [L], z, z) if down else rk.calc([L], z, z, z, [-sigma], z)
         if traj is None or not _within(traj, 0.0, L):
             return None
         return traj
 
-    def legs(self, slot: Slot) -> list[_Leg]:
-        """Candidate via speeds of a slot's vertical leg with their durations (cached per slot)."""
+    def legs(self, slot: Slot) -> _LegCandidates:
+        """Candidate via speeds of a slot's vertical leg, fastest first, with their durations (cached per slot)."""
         if slot not in self._legs:
             vp, _, pl = self._path(slot)
             smax = 0.999 * min(pl.v, _braking_speed(vp.length_m, pl.a, pl.j))
             fractions = self.config.via_fractions if self.pass_through else (0.0,)
-            out: list[_Leg] = []
-            for f in sorted({*fractions, 0.0}, reverse=True):
-                traj = self.path_traj(slot, f * smax, down=True)
-                if traj is not None:
-                    out.append(_Leg(f * smax, traj.duration))
-            self._legs[slot] = out
+            self._legs[slot] = _LegCandidates([f * smax for f in sorted({*fractions, 0.0}, reverse=True)],
+                                              lambda sigma: self.path_traj(slot, sigma, down=True))
         return self._legs[slot]
 
     def via_state(self, slot: Slot | None, sigma: float, down: bool) -> tuple[FloatArray, FloatArray]:
@@ -608,24 +640,53 @@ class _Builder:
 
         def horizontal_uncached(q0: FloatArray, slot0: Slot | None, q1: FloatArray,
                                 slot1: Slot | None) -> tuple[float, float, RuckigTrajectory]:
-            c0 = self.legs(slot0) if slot0 is not None else [_Leg(0.0, 0.0)]
-            c1 = self.legs(slot1) if slot1 is not None else [_Leg(0.0, 0.0)]
-            best: tuple[float, float, float, RuckigTrajectory] | None = None
-            # Candidate states as lists once (not per Ruckig call: 36 calls per connection by default).
+            c0 = self.legs(slot0) if slot0 is not None else _AT_REST
+            c1 = self.legs(slot1) if slot1 is not None else _AT_REST
+            # Candidate states as lists (converted once per candidate, not per Ruckig call).
             q0l, q1l = q0.tolist(), q1.tolist()
-            ends = [(l1, *(x.tolist() for x in self.via_state(slot1, l1.sigma, down=True))) for l1 in c1]
-            for l0 in c0:
-                v0, a0 = (x.tolist() for x in self.via_state(slot0, l0.sigma, down=False))
-                for l1, v1, a1 in ends:
-                    traj = self.rk.calc(q0l, v0, a0, q1l, v1, a1)
-                    if traj is None:
-                        continue  # fall back to the next (smaller) via speed
-                    cost = l0.duration + traj.duration + l1.duration
-                    if best is None or cost < best[0]:
-                        best = (cost, l0.sigma, l1.sigma, traj)
-            if best is None:
+            starts: dict[int, list[list[float]]] = {}
+            ends: dict[int, list[list[float]]] = {}
+            tried: dict[tuple[int, int], tuple[float, RuckigTrajectory | None]] = {}
+
+            def cost(i: int, j: int) -> float:
+                """Summed duration of exit leg i, the connection and entry leg j (inf: a leg or Ruckig failed)."""
+                if (i, j) not in tried:
+                    l0, l1 = c0.get(i), c1.get(j)
+                    traj = None
+                    if l0 is not None and l1 is not None:
+                        if i not in starts:
+                            starts[i] = [x.tolist() for x in self.via_state(slot0, l0.sigma, down=False)]
+                        if j not in ends:
+                            ends[j] = [x.tolist() for x in self.via_state(slot1, l1.sigma, down=True)]
+                        traj = self.rk.calc(q0l, *starts[i], q1l, *ends[j])
+                    # A failed calculate drops the candidate (the next, smaller via speed is tried instead).
+                    tried[(i, j)] = (math.inf, None) if traj is None or l0 is None or l1 is None else (
+                        l0.duration + traj.duration + l1.duration, traj)
+                return tried[(i, j)][0]
+
+            # Descent over the (exit speed, entry speed) candidate grid from the fastest pair, stepping to the best
+            # improving 4-neighbour: the summed duration is unimodal over this grid in practice (the optimum has one
+            # of the two speeds at its largest candidate), and the descent found the same optimum as the full
+            # 6 x 6 search on every connection of the lab stations (all pairs, N = 1..3) and of a 10-level grid
+            # (N = 1..7), with ~1/7 of the Ruckig calls.
+            cur = (0, 0)
+            while True:
+                i, j = cur
+                nbrs = [(i + di, j + dj) for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1))
+                        if i + di >= 0 and j + dj >= 0 and c0.get(i + di) is not None and c1.get(j + dj) is not None]
+                nxt = min(nbrs, key=lambda ij: cost(*ij), default=cur)
+                if not cost(*nxt) < cost(*cur):
+                    break
+                cur = nxt
+            if math.isinf(cost(*cur)):  # no feasible candidate near the fastest pair: try them all
+                cur = min(itertools.product(range(c0.count()), range(c1.count())), key=lambda ij: cost(*ij),
+                          default=cur)
+            traj = tried[cur][1]
+            if traj is None:
                 raise PlanError(f"Ruckig could not connect {np.round(q0, 4).tolist()} to {np.round(q1, 4).tolist()}")
-            return best[1], best[2], best[3]
+            l0, l1 = c0.get(cur[0]), c1.get(cur[1])
+            assert l0 is not None and l1 is not None
+            return l0.sigma, l1.sigma, traj
 
         def vertical(phase: Phase, mi: int, slot: Slot, sigma: float, down: bool) -> None:
             traj = self.path_traj(slot, sigma, down)
@@ -740,8 +801,9 @@ class _ProfileTable:
         # at or before it (upper_bound, as Ruckig), i.e. a running count minus the 7 ends of every earlier segment.
         pos = np.searchsorted(_lexi_keys(seg, tau), _lexi_keys(np.repeat(segs, D * 7), self.t_sum[rows].ravel()),
                               side="left")
-        lane = np.tile(np.repeat(np.arange(D), 7), len(segs))
-        marks = np.bincount(lane * (n + 1) + pos, minlength=D * (n + 1)).reshape(D, n + 1)
+        # Each DoF counts into its own lane of n + 1 slots (pos is ordered segment, DoF, phase end).
+        lanes = (np.arange(D)[:, None] * (n + 1) + pos.reshape(len(segs), D, 7)).ravel()
+        marks = np.bincount(lanes, minlength=D * (n + 1)).reshape(D, n + 1)
         earlier = np.cumsum(row_of_seg >= 0) - 1  # rank of each segment among this table's segments
         piece = np.cumsum(marks[:, :n], axis=1) - 7 * earlier[seg]
         flat = (row_of_seg[seg] * D + np.arange(D)[:, None]) * _N_PIECES + piece
@@ -818,6 +880,21 @@ class _StackedPaths:
         return q, dq, ddq, dddq
 
 
+# Stacked nodes per set of paths (by identity; the entry holds the paths, so their ids are not reused while cached).
+# The paths come from the per-station waypoint cache, so repeated plans on a station reuse the same stacks.
+_STACKED_CACHE: dict[tuple[int, ...], tuple[tuple[VerticalPath, ...], _StackedPaths]] = {}
+
+
+def _stacked_paths(paths: Sequence[VerticalPath]) -> _StackedPaths:
+    key = tuple(id(vp) for vp in paths)
+    hit = _STACKED_CACHE.get(key)
+    if hit is None:
+        if len(_STACKED_CACHE) >= 64:
+            _STACKED_CACHE.clear()
+        hit = _STACKED_CACHE[key] = (tuple(paths), _StackedPaths(paths))
+    return hit[1]
+
+
 def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
     """Uniform samples ``t = i / rate_hz`` of the chained segments, with suction, move index and phase.
 
@@ -831,9 +908,11 @@ def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
     n_seg = len(segments)
     starts = np.array([s.t_start for s in segments])
     durations = np.array([s.duration for s in segments])
-    seg_of = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, n_seg - 1)
+    # searchsorted <= n_seg, so only the lower bound needs clamping (np.clip has a much larger fixed cost).
+    seg_of = np.maximum(np.searchsorted(starts, t, side="right") - 1, 0)
     tau = np.minimum(t - starts[seg_of], durations[seg_of])
-    phase = np.array([int(s.phase) for s in segments], dtype=int)[seg_of]
+    seg_phase = np.array([int(s.phase) for s in segments], dtype=int)
+    phase = seg_phase[seg_of]
     mi = np.array([s.move_index for s in segments], dtype=int)[seg_of]
 
     # Table rows per segment (-1: none). The builder reuses one Ruckig trajectory for repeated legs, so each
@@ -876,7 +955,7 @@ def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
     idx = np.flatnonzero(row_of_seg[1, seg_of] >= 0)
     if idx.size:
         s_all = _ProfileTable.of(profiles[1]).evaluate(seg_of[idx], row_of_seg[1], tau[idx])
-        stacked = _StackedPaths(path_list)
+        stacked = _stacked_paths(path_list)
         which = path_of_seg[seg_of[idx]]
         for c in range(0, len(idx), _CHUNK):
             ii, cc = idx[c:c + _CHUNK], slice(c, c + _CHUNK)
@@ -901,7 +980,8 @@ def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
     # Samples after the end (the last one) hold the final state at rest.
     last = t > duration
     qd[:, last], qdd[:, last], qddd[:, last] = 0.0, 0.0, 0.0
-    suction = np.isin(phase, [int(p) for p in SUCTION_PHASES])
+    # Per segment then gathered (np.isin has a large fixed cost, ~0.1 ms, against a few us for this).
+    suction = np.array([seg.phase in SUCTION_PHASES for seg in segments], dtype=bool)[seg_of]
     q, qd, qdd, qddd = (np.ascontiguousarray(x.T) for x in (q, qd, qdd, qddd))
     return Trajectory(rate_hz=float(rate_hz), t=t, q=q, qd=qd, qdd=qdd, qddd=qddd, suction=suction,
                       move_index=mi, phase=phase)
