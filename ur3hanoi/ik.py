@@ -20,7 +20,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from ur3hanoi.errors import IKError, Ur3HanoiError
-from ur3hanoi.robot import DH_A, DH_ALPHA, DH_D, N_JOINTS, T_BASELINK_BASE, JointLimits, Ur3Model, dh_fk
+from ur3hanoi.robot import DH_A, DH_ALPHA, DH_D, T_BASELINK_BASE, JointLimits, Ur3Model, dh_fk
 
 FloatArray = npt.NDArray[np.float64]
 Branch = tuple[int, int, int]
@@ -132,18 +132,20 @@ def _inv_h(T: FloatArray) -> FloatArray:
 
 def nearest_equivalent(q: FloatArray, q_ref: FloatArray, limits: JointLimits) -> FloatArray | None:
     """Each joint of ``q`` shifted by a multiple of 2pi to be nearest ``q_ref`` within limits (None if none fits)."""
-    q = np.asarray(q, dtype=float)
-    q_ref = np.asarray(q_ref, dtype=float)
-    out = q_ref + wrap_angle(q - q_ref)
-    lo, hi = np.asarray(limits.q_min), np.asarray(limits.q_max)
-    for i in range(N_JOINTS):
-        if out[i] > hi[i] + 1e-12:
-            out[i] -= 2 * math.pi
-        elif out[i] < lo[i] - 1e-12:
-            out[i] += 2 * math.pi
-        if not lo[i] - 1e-12 <= out[i] <= hi[i] + 1e-12:
+    out = []
+    # Six scalars: plain floats are several times faster than numpy here, and this runs for every table pose.
+    for qi, ri, lo, hi in zip(np.asarray(q, dtype=float).tolist(), np.asarray(q_ref, dtype=float).tolist(),
+                              limits.q_min, limits.q_max, strict=True):
+        x = ri + (qi - ri + math.pi) % (2 * math.pi) - math.pi
+        # The nearest equivalent overshoots a limit only when q_ref is within pi of it: take the other turn.
+        if x > hi + 1e-12:
+            x -= 2 * math.pi
+        elif x < lo - 1e-12:
+            x += 2 * math.pi
+        if not lo - 1e-12 <= x <= hi + 1e-12:
             return None
-    return out
+        out.append(x)
+    return np.array(out)
 
 
 # ------------------------------------------------------------------------------------------------- solvers
@@ -192,6 +194,7 @@ class PinocchioIK:
         self.damping = damping
         self.stop_tol = stop_tol
         self._fid = robot.frame_ids["tcp"]
+        self._damping_eye = damping * np.eye(6)
 
     def solve(self, T_base_tcp: pin.SE3, q_seed: FloatArray) -> IKResult:
         model, data = self.robot.model, self.robot.data
@@ -200,22 +203,22 @@ class PinocchioIK:
         q = np.array(q_seed, dtype=float)
         it = 0
         for it in range(1, self.max_iterations + 1):
-            pin.framesForwardKinematics(model, data, q)
-            iMd = data.oMf[self._fid].actInv(target)
+            pin.forwardKinematics(model, data, q)
+            iMd = pin.updateFramePlacement(model, data, self._fid).actInv(target)
             err = pin.log6(iMd).vector
-            if float(np.linalg.norm(err)) < self.stop_tol:
+            if math.sqrt(err @ err) < self.stop_tol:
                 break
             J = pin.computeFrameJacobian(model, data, q, self._fid, pin.LOCAL)
             J = -pin.Jlog6(iMd.inverse()) @ J
-            dq = -J.T @ np.linalg.solve(J @ J.T + self.damping * np.eye(6), err)
+            dq = -J.T @ np.linalg.solve(J @ J.T + self._damping_eye, err)
             # Cap the step: far from the solution a full Gauss-Newton step can leap across branches.
             step = float(np.max(np.abs(dq)))
             if step > 0.5:
                 dq *= 0.5 / step
             q = q + dq
         else:
-            pin.framesForwardKinematics(model, data, q)
-            iMd = data.oMf[self._fid].actInv(target)
+            pin.forwardKinematics(model, data, q)
+            iMd = pin.updateFramePlacement(model, data, self._fid).actInv(target)
         # iMd is the target seen from the reached TCP: its translation norm is the position error.
         dp = float(np.linalg.norm(iMd.translation))
         dr = float(np.linalg.norm(pin.log3(iMd.rotation)))
@@ -287,7 +290,7 @@ def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3, q_home: FloatArray, l
     q_home = np.asarray(q_home, dtype=float)
     if home_branch is None:
         home_branch = branch_of(q_home)
-    T_base_tool0 = T_base_tcp * robot.T_flange_tcp("tool0").inverse()
+    T_base_tool0 = T_base_tcp * robot.T_tcp_tool0
 
     def where() -> str:
         xyz = np.round(T_base_tcp.translation, 4).tolist()

@@ -236,6 +236,8 @@ class Ur3Model:
         self.frame_ids = {name: self.model.getFrameId(name) for name in ("base", "base_link", "tool0", "tcp")}
         self.frame_ids["ee_link"] = self.model.getFrameId("ee_link")
         self._T_base_baselink = T_BASELINK_BASE.inverse()
+        # The flange seen from the TCP: constant, used by every IK solve to turn a TCP target into a flange one.
+        self.T_tcp_tool0: pin.SE3 = self.T_flange_tcp("tool0").inverse()
 
     @property
     def nq(self) -> int:
