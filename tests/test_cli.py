@@ -37,7 +37,7 @@ def test_unreachable_grid_exits_2_with_one_line_and_writes_nothing(tmp_path: Pat
     assert main(["tables", str(cal), "--key", "real_pos", "-o", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
-    assert "tower 2 height 0 on" in err and "unreachable" in err and "target xyz" in err
+    assert "tower 2 height 0 on" in err and "unreachable" in err and "target xyz" in err and "residual" in err
     assert not out.exists()
 
 

@@ -275,6 +275,14 @@ def make_solver(name: str, robot: Ur3Model) -> IKSolver:
     raise Ur3HanoiError(f"IK solver {name!r} is unknown: expected one of {SOLVERS}")
 
 
+def closest_reach(robot: Ur3Model, T_base_tcp: pin.SE3, q_seed: FloatArray) -> IKResult:
+    """Heavily damped least squares from ``q_seed``: the pose closest to an unreachable target, for its residual.
+
+    Damping keeps the steps bounded at the workspace boundary, where the Jacobian is singular.
+    """
+    return PinocchioIK(robot, max_iterations=300, damping=1e-3).solve(T_base_tcp, q_seed)
+
+
 def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3, q_home: FloatArray, label: str = "pose",
                     home_branch: Branch | None = None) -> IKResult:
     """Solve ``T_base_tcp`` on the branch of ``q_home``, each joint the 2pi-equivalent nearest home.
@@ -301,7 +309,10 @@ def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3, q_home: FloatArray, l
     if not branches:
         reachable = sorted(analytic_ik(T_base_tool0))
         if not reachable:
-            raise IKError(f"{where()} is unreachable by the UR3 (no closed-form solution on any branch)")
+            best = closest_reach(robot, T_base_tcp, q_home)
+            raise IKError(f"{where()} is unreachable by the UR3 (no closed-form solution; closest reach leaves a "
+                          f"residual of {best.position_error * 1e3:.1f} mm, {math.degrees(best.orientation_error):.1f}"
+                          " deg)")
         raise IKError(f"{where()} has no solution on home's branch {home_branch} (reachable: {reachable})")
     seed = q_home + wrap_angle(branches[home_branch] - q_home)
     res = solver.solve(T_base_tcp, seed)
