@@ -322,18 +322,10 @@ class VerticalPath:
                 np.max(np.abs(self.dddq), axis=0))
 
     def evaluate(self, s: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """(q, dq/ds, d2q/ds2, d3q/ds3) at ``s`` [m] (clamped to [0, length_m])."""
-        s = min(max(s, 0.0), self.length_m)
-        k = int(min(np.searchsorted(self.s, s, side="right") - 1, len(self.s) - 2))
-        h = self.s[k + 1] - self.s[k]
-        u = (s - self.s[k]) / h
-        q0, q1, m0, m1 = self.q[k], self.q[k + 1], self.dq[k] * h, self.dq[k + 1] * h
-        u2, u3 = u * u, u * u * u
-        q = (2 * u3 - 3 * u2 + 1) * q0 + (u3 - 2 * u2 + u) * m0 + (-2 * u3 + 3 * u2) * q1 + (u3 - u2) * m1
-        dq = ((6 * u2 - 6 * u) * q0 + (3 * u2 - 4 * u + 1) * m0 + (-6 * u2 + 6 * u) * q1 + (3 * u2 - 2 * u) * m1) / h
-        ddq = (1 - u) * self.ddq[k] + u * self.ddq[k + 1]
-        dddq = (1 - u) * self.dddq[k] + u * self.dddq[k + 1]
-        return q, dq, ddq, dddq
+        """(q, dq/ds, d2q/ds2, d3q/ds3) at ``s`` [m] (clamped to [0, length_m]): a cubic Hermite spline through
+        the IK nodes for q and dq/ds, linear for the higher derivatives."""
+        q, dq, ddq, dddq = self.evaluate_many(np.array([s], dtype=float))
+        return q[0], dq[0], ddq[0], dddq[0]
 
     def evaluate_many(self, s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """:meth:`evaluate` at every ``s`` (N,) [m] at once: four (N, 6) arrays, with the same arithmetic."""
