@@ -20,7 +20,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from ur3hanoi.errors import IKError, Ur3HanoiError
-from ur3hanoi.robot import DH_A, DH_ALPHA, DH_D, T_BASELINK_BASE, JointLimits, Ur3Model, dh_fk
+from ur3hanoi.robot import DH_A, DH_D, T_BASELINK_BASE, JointLimits, Ur3Model, dh_fk, dh_link
 
 FloatArray = npt.NDArray[np.float64]
 Branch = tuple[int, int, int]
@@ -99,7 +99,7 @@ def analytic_ik(T_base_tool0: FloatArray | pin.SE3, only: Branch | None = None) 
                 continue
             q6 = math.atan2(-float(R[:, 1] @ z1) / sin5, float(R[:, 0] @ z1) / sin5)
             # Planar 3R problem (joints 2-4) in DH frame 1.
-            T14 = _inv_h(_dh(q1, 0)) @ T @ _inv_h(_dh(q5, 4) @ _dh(q6, 5))
+            T14 = _inv_h(dh_link(q1, 0)) @ T @ _inv_h(dh_link(q5, 4) @ dh_link(q6, 5))
             px, py = T14[0, 3], T14[1, 3]
             c3 = (px * px + py * py - a2 * a2 - a3 * a3) / (2 * a2 * a3)
             if abs(c3) > 1.0:
@@ -111,15 +111,6 @@ def analytic_ik(T_base_tool0: FloatArray | pin.SE3, only: Branch | None = None) 
                 # By construction the branch is (s1, s3, s5): see branch_of.
                 out[(s1, s3, s5)] = wrap_angle(np.array([q1, q2, q3, q4, q5, q6]))
     return out
-
-
-def _dh(theta: float, i: int) -> FloatArray:
-    ct, st = math.cos(theta), math.sin(theta)
-    ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
-    return np.array(
-        [[ct, -st * ca, st * sa, DH_A[i] * ct], [st, ct * ca, -ct * sa, DH_A[i] * st], [0, sa, ca, DH_D[i]],
-         [0, 0, 0, 1.0]]
-    )
 
 
 def _inv_h(T: FloatArray) -> FloatArray:

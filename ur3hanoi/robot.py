@@ -108,10 +108,6 @@ class ToolOffset:
     xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
-    def T_parent_tcp(self) -> pin.SE3:
-        """The TCP pose in its parent flange frame."""
-        return pin.SE3(pin.rpy.rpyToMatrix(*self.rpy), np.array(self.xyz, dtype=float))
-
 
 FLANGE_FRAMES: tuple[str, ...] = ("ee_link", "tool0")
 
@@ -166,6 +162,19 @@ def urdf_text(tool: ToolOffset | None = None, absolute_meshes: bool = True) -> s
         )
         text = re.sub(r"</robot>\s*$", tcp + "</robot>\n", text)
     return text
+
+
+def dh_link(theta: float, i: int) -> FloatArray:
+    """4x4 DH transform of joint ``i`` (0-based) at angle ``theta`` [rad]: Rz(theta) Tz(d) Tx(a) Rx(alpha).
+
+    Scalar form for the closed-form IK's hot path; :func:`dh_fk` builds the same matrices vectorized.
+    """
+    ct, st = math.cos(theta), math.sin(theta)
+    ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
+    return np.array(
+        [[ct, -st * ca, st * sa, DH_A[i] * ct], [st, ct * ca, -ct * sa, DH_A[i] * st], [0.0, sa, ca, DH_D[i]],
+         [0.0, 0.0, 0.0, 1.0]]
+    )
 
 
 def dh_fk(q: FloatArray) -> FloatArray:
@@ -286,6 +295,7 @@ __all__ = [
     "ToolOffset",
     "Ur3Model",
     "dh_fk",
+    "dh_link",
     "load_ur3",
     "package_dir",
     "urdf_path",

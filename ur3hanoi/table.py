@@ -24,7 +24,7 @@ import numpy.typing as npt
 import yaml
 
 from ur3hanoi import __version__
-from ur3hanoi.errors import IKError, TableError
+from ur3hanoi.errors import TableError
 from ur3hanoi.grid import POSE_NAMES, T_base_tcp, T_world_tcp, block_xy_pos
 from ur3hanoi.ik import IKResult, IKSolver, branch_of, make_solver, pose_errors, solve_on_branch
 from ur3hanoi.robot import N_JOINTS, load_ur3
@@ -317,7 +317,6 @@ __all__ = [
     "BLOCK_XY_KEY",
     "TABLE_KEYS",
     "CheckRow",
-    "IKError",
     "Table",
     "atomic_write",
     "check_table",
