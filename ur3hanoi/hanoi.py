@@ -39,6 +39,13 @@ def block_colour(block: int) -> str:
     return BLOCK_COLOURS[block] if block < len(BLOCK_COLOURS) else f"block{block + 1}"
 
 
+def _start_stacks(n_blocks: int, start: int, n_towers: int) -> list[list[int]]:
+    """Tower contents (bottom first) with every block on ``start``."""
+    stacks: list[list[int]] = [[] for _ in range(n_towers)]
+    stacks[start] = list(range(n_blocks))
+    return stacks
+
+
 def validate_instance(n_blocks: int, start: int, end: int, n_towers: int, n_heights: int) -> None:
     """Reject start == end, towers outside the grid and more blocks than heights (0-based towers)."""
     if n_towers < 3:
@@ -59,8 +66,7 @@ def solve_hanoi(n_blocks: int, start: int, end: int, n_towers: int = 3, n_height
     """
     validate_instance(n_blocks, start, end, n_towers, n_heights if n_heights is not None else n_blocks)
     via = next(t for t in range(n_towers) if t not in (start, end))
-    stacks: dict[int, list[int]] = {t: [] for t in range(n_towers)}
-    stacks[start] = list(range(n_blocks))
+    stacks = _start_stacks(n_blocks, start, n_towers)
     moves: list[Move] = []
 
     # Iterative form of the recursion (no recursion limit for tall synthetic grids).
@@ -69,7 +75,7 @@ def solve_hanoi(n_blocks: int, start: int, end: int, n_towers: int = 3, n_height
         n, src, dst, spare = work.pop()
         if n == 0:
             continue
-        if n < 0:  # marker: perform the single move of block (-n - 1)
+        if n < 0:  # marker: move the top block of src to dst (its block and heights come from the replayed stacks)
             block = stacks[src].pop()
             moves.append(Move(block, src, len(stacks[src]), dst, len(stacks[dst])))
             stacks[dst].append(block)
@@ -91,8 +97,7 @@ def check_sequence(moves: Sequence[Move], n_blocks: int, start: int, end: int, n
         PuzzleError: naming the first illegal move (1-based) and why.
     """
     validate_instance(n_blocks, start, end, n_towers, n_heights)
-    stacks: list[list[int]] = [[] for _ in range(n_towers)]
-    stacks[start] = list(range(n_blocks))
+    stacks = _start_stacks(n_blocks, start, n_towers)
     for i, m in enumerate(moves, start=1):
         where = f"move {i} (block {m.block + 1}, tower {m.from_tower + 1} -> {m.to_tower + 1})"
         for t in (m.from_tower, m.to_tower):
@@ -123,8 +128,7 @@ def stacks_before_moves(moves: Sequence[Move], n_blocks: int, start: int, n_towe
 
     The moves are replayed without legality checks (use :func:`check_sequence` for that).
     """
-    stacks: list[list[int]] = [[] for _ in range(n_towers)]
-    stacks[start] = list(range(n_blocks))
+    stacks = _start_stacks(n_blocks, start, n_towers)
     out = [[list(s) for s in stacks]]
     for m in moves:
         stacks[m.to_tower].append(stacks[m.from_tower].pop())

@@ -55,7 +55,7 @@ from ruckig import InputParameter, Result, Ruckig
 from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.errors import PlanError
-from ur3hanoi.grid import ABOVE, ON, T_base_tcp, T_world_tcp, block_center_world, table_z
+from ur3hanoi.grid import ABOVE, ON, R_world_tcp_down, T_base_tcp, block_center_world, contact_point_world, table_z
 from ur3hanoi.hanoi import Move, check_sequence, solve_hanoi, stacks_before_moves
 from ur3hanoi.ik import analytic_ik, branch_of, nearest_equivalent
 from ur3hanoi.robot import N_JOINTS, T_BASELINK_BASE, Ur3Model, dh_fk, load_ur3
@@ -303,7 +303,6 @@ class VerticalPath:
         dq: (M, 6) dq/ds [rad/m] (exact: J^-1 of a straight-down unit twist).
         ddq, dddq: (M, 6) d2q/ds2 [rad/m^2], d3q/ds3 [rad/m^3] by finite differences of dq/ds.
         length_m: approach length [m].
-        line_xy: world xy [m] of the vertical line (the contact suction point).
     """
 
     s: FloatArray
@@ -312,7 +311,6 @@ class VerticalPath:
     ddq: FloatArray
     dddq: FloatArray
     length_m: float
-    line_xy: FloatArray
 
     @cached_property
     def derivative_bounds(self) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -351,26 +349,31 @@ class Waypoints:
     vertical: tuple[tuple[VerticalPath, ...], ...]  # [tower][height]
 
 
-def _tangent_down(robot: Ur3Model, station: Station, q: FloatArray) -> FloatArray:
+def _tangent_down(robot: Ur3Model, R_world_base: FloatArray, q: FloatArray) -> FloatArray:
     """Joint velocity moving the TCP at 1 m/s along world -z without rotating (J^-1 of the twist)."""
     J = robot.frame_jacobian_local(q, "tcp")
-    R_world_tcp = station.T_world_base.rotation @ robot.fk(q, "tcp").rotation
+    R_world_tcp = R_world_base @ robot.fk(q, "tcp").rotation
     twist = np.concatenate([R_world_tcp.T @ np.array([0.0, 0.0, -1.0]), np.zeros(3)])
     return np.linalg.solve(J, twist)
 
 
-def _ik_on_line(robot: Ur3Model, station: Station, tower: int, height: int, s: float,
-                q_ref: FloatArray) -> FloatArray:
-    """Closed-form IK [rad] of the suction point ``s`` [m] below the above pose, on home's branch, nearest q_ref."""
-    T = T_base_tcp(station, tower, height, ABOVE)
-    T = pin.SE3(T.rotation, T.translation - station.T_world_base.rotation.T @ np.array([0.0, 0.0, s]))
-    sols = analytic_ik(T * robot.T_flange_tcp("tool0").inverse())
+def _line_ik(robot: Ur3Model, station: Station, tower: int, height: int) -> Callable[[float, FloatArray], FloatArray]:
+    """``ik(s, q_ref)``: closed-form IK [rad] of the suction point ``s`` [m] below the above pose of (tower, height),
+    on home's branch, nearest ``q_ref``."""
+    T_above = T_base_tcp(station, tower, height, ABOVE)
+    R_base_world = station.T_world_base.rotation.T
     branch = branch_of(station.q_home_array)
-    q = nearest_equivalent(sols[branch], q_ref, station.limits) if branch in sols else None
-    if q is None:
-        raise PlanError(f"tower {tower + 1} height {height + 1}: the vertical line {s * 1e3:.1f} mm below the "
-                        "above pose has no IK solution on home's branch within the joint limits")
-    return q
+
+    def ik(s: float, q_ref: FloatArray) -> FloatArray:
+        T = pin.SE3(T_above.rotation, T_above.translation - R_base_world @ np.array([0.0, 0.0, s]))
+        sols = analytic_ik(T * robot.T_tcp_tool0, only=branch)
+        q = nearest_equivalent(sols[branch], q_ref, station.limits) if branch in sols else None
+        if q is None:
+            raise PlanError(f"tower {tower + 1} height {height + 1}: the vertical line {s * 1e3:.1f} mm below the "
+                            "above pose has no IK solution on home's branch within the joint limits")
+        return q
+
+    return ik
 
 
 @lru_cache(maxsize=32)
@@ -378,31 +381,31 @@ def build_waypoints(station: Station, node_step_m: float = 0.002) -> Waypoints:
     """Table by IK on the home branch, plus the vertical path of every slot. Cached per station."""
     table = generate_table(station)
     robot = load_ur3(station.tool, station.limits)
+    R_world_base = station.T_world_base.rotation
     h_fd = 1e-3  # [m] finite-difference step of the higher path derivatives
+    L = station.approach
+    n = max(2, math.ceil(L / node_step_m)) + 1
+    s_nodes = np.linspace(0.0, L, n)
     vertical = []
     for t in range(station.n_towers):
         col = []
         for h in range(station.n_heights):
-            L = station.approach
-            n = max(2, math.ceil(L / node_step_m)) + 1
-            s_nodes = np.linspace(0.0, L, n)
+            ik = _line_ik(robot, station, t, h)
             q_nodes = np.empty((n, N_JOINTS))
             q_ref = table.q[t, h, ABOVE]
             for k, s in enumerate(s_nodes):
-                q_nodes[k] = q_ref = _ik_on_line(robot, station, t, h, float(s), q_ref)
+                q_nodes[k] = q_ref = ik(float(s), q_ref)
             # The ends are the table's entries exactly (they agree with closed-form IK to ~1e-11 rad).
             q_nodes[0], q_nodes[-1] = table.q[t, h, ABOVE], table.q[t, h, ON]
-            dq = np.array([_tangent_down(robot, station, q) for q in q_nodes])
+            dq = np.array([_tangent_down(robot, R_world_base, q) for q in q_nodes])
             ddq = np.empty_like(dq)
             dddq = np.empty_like(dq)
             for k, (s, q) in enumerate(zip(s_nodes, q_nodes, strict=True)):
-                qm = _ik_on_line(robot, station, t, h, float(s) - h_fd, q)
-                qp = _ik_on_line(robot, station, t, h, float(s) + h_fd, q)
-                dm, dp = _tangent_down(robot, station, qm), _tangent_down(robot, station, qp)
+                dm = _tangent_down(robot, R_world_base, ik(float(s) - h_fd, q))
+                dp = _tangent_down(robot, R_world_base, ik(float(s) + h_fd, q))
                 ddq[k] = (dp - dm) / (2 * h_fd)
                 dddq[k] = (dp - 2 * dq[k] + dm) / (h_fd * h_fd)
-            line_xy = T_world_tcp(station, t, h, ON).translation[:2].copy()
-            col.append(VerticalPath(s=s_nodes, q=q_nodes, dq=dq, ddq=ddq, dddq=dddq, length_m=L, line_xy=line_xy))
+            col.append(VerticalPath(s=s_nodes, q=q_nodes, dq=dq, ddq=ddq, dddq=dddq, length_m=L))
         vertical.append(tuple(col))
     return Waypoints(q_home=station.q_home_array, table=table.q, vertical=tuple(vertical))
 
@@ -425,7 +428,6 @@ class _Ruckig:
         self.inp.max_acceleration = [float(x) for x in a_max]
         self.inp.max_jerk = [float(x) for x in j_max]
         self.seconds = 0.0
-        self.calls = 0
 
     def calc(self, q0: FloatArray | list[float], v0: FloatArray | list[float], a0: FloatArray | list[float],
              q1: FloatArray | list[float], v1: FloatArray | list[float],
@@ -448,7 +450,6 @@ class _Ruckig:
         except RuntimeError:  # RuckigError: a state outside the limits (rounding at a via point)
             result = Result.ErrorInvalidInput
         self.seconds += time.perf_counter() - t0
-        self.calls += 1
         # Offline calculate reports success as Working (Finished only for a zero-length segment).
         if result not in (Result.Working, Result.Finished):
             return None
@@ -541,7 +542,6 @@ class _Builder:
     """Chains Ruckig segments for a move sequence (pass-through or stop-and-go)."""
 
     def __init__(self, station: Station, wp: Waypoints, config: PlanConfig, pass_through: bool = True) -> None:
-        self.station = station
         self.wp = wp
         self.config = config
         self.pass_through = pass_through and config.pass_through
@@ -1042,8 +1042,8 @@ def check_vertical(tr: Trajectory, moves: Sequence[Move], station: Station, tol_
     mi = tr.move_index[vert]
     at_src = np.isin(tr.phase[vert], [int(Phase.DESCEND_PICK), int(Phase.LIFT)])
     slot = np.where(at_src[:, None], src[mi], dst[mi])
-    line_xy = np.array([[T_world_tcp(station, t, h, ON).translation[:2] for h in range(station.n_heights)]
-                        for t in range(station.n_towers)]).reshape(station.n_towers, station.n_heights, 2)
+    line_xy = np.array([[contact_point_world(station, t, h)[:2] for h in range(station.n_heights)]
+                        for t in range(station.n_towers)])
     p = _tcp_positions_world(station, tr.q[vert])
     dev = np.linalg.norm(p[:, :2] - line_xy[slot[:, 0], slot[:, 1]], axis=1)
     for i in np.flatnonzero(dev > tol_m)[:5]:
@@ -1132,9 +1132,6 @@ class CollisionScene:
                 gm.addCollisionPair(pin.CollisionPair(a, b))
         self.gd = pin.GeometryData(gm)
         self.R = self._reach_bounds()
-        self._R_block = pin.SE3(np.eye(3), np.zeros(3))
-        from ur3hanoi.grid import R_world_tcp_down
-
         self._R_block = R_world_tcp_down(station.tool_yaw)
 
     def _reach_bounds(self) -> FloatArray:
@@ -1168,10 +1165,21 @@ class CollisionScene:
         return self.gm.geometryObjects[gid].name
 
 
+@lru_cache(maxsize=8)
+def _collision_scene(station: Station, n_blocks: int) -> CollisionScene:
+    """The scene of a station and block count, built once: reading and hulling the URDF meshes (~0.2 s) is most of
+    a clearance check otherwise. Shared like ``load_ur3``'s models, so not thread-safe either."""
+    return CollisionScene(station, n_blocks)
+
+
 def check_collisions(tr: Trajectory, moves: Sequence[Move], station: Station, n_blocks: int, start: int,
                      config: PlanConfig, limits: KinematicLimits) -> list[str]:
     """Clearance checks of :class:`CollisionScene` on the sampled trajectory (decimated with a proven margin)."""
-    scene = CollisionScene(station, n_blocks)
+    scene = _collision_scene(station, n_blocks)
+    # Fresh GeometryData: Pinocchio warm-starts GJK from each pair's previous query (enable_cached_gjk_guess), so
+    # reusing it would let the distances depend, in the last bits, on the plans checked before. Block placements
+    # need no reset: every run below places all blocks before its first query.
+    scene.gd = pin.GeometryData(scene.gm)
     stacks = stacks_before_moves(moves, n_blocks, start, station.n_towers)
     out: list[str] = []
     dt = 1.0 / tr.rate_hz
@@ -1259,8 +1267,8 @@ def plan_moves(station: Station, moves: Sequence[Move], config: PlanConfig | Non
     t0 = time.perf_counter()
     wp = build_waypoints(station)
     timings["waypoints"] = time.perf_counter() - t0
-    limits = config.limits(station)
     builder = _Builder(station, wp, config)
+    limits = builder.limits
     t0 = time.perf_counter()
     segments = builder.build(moves)
     timings["build"] = time.perf_counter() - t0
