@@ -258,3 +258,10 @@ def test_via_descent_finds_grid_optimum(stations: dict[str, Station]) -> None:
                 if t is not None:
                     best = min(best, l0.duration + t.duration + l1.duration)
             assert chosen == pytest.approx(best, abs=1e-12)
+
+
+@pytest.mark.parametrize("field", ["collision_rate_hz", "vertical_tol_m", "clearance_m"])
+@pytest.mark.parametrize("value", [float("nan"), 0.0, -1.0, float("inf")])
+def test_config_rejects_non_finite_or_non_positive(field: str, value: float) -> None:
+    with pytest.raises(PlanError, match=field):
+        dataclasses.replace(PlanConfig(), **{field: value}).validate()

@@ -173,8 +173,10 @@ class PlanConfig:
                 raise PlanError(f"{name} = {v!r} is invalid: expected {N_JOINTS} positive numbers")
         if not self.via_fractions or not all(0.0 <= f <= 1.0 for f in self.via_fractions):
             raise PlanError(f"via_fractions = {self.via_fractions!r} is invalid: expected values in [0, 1]")
-        if self.collision_rate_hz <= 0:
-            raise PlanError(f"collision_rate_hz = {self.collision_rate_hz!r} is invalid: expected > 0")
+        for name in ("collision_rate_hz", "vertical_tol_m", "clearance_m"):
+            x = getattr(self, name)
+            if not (math.isfinite(x) and x > 0.0):  # NaN compares False everywhere: test finiteness explicitly
+                raise PlanError(f"{name} = {x!r} is invalid: expected a finite number > 0")
 
     def limits(self, station: Station) -> KinematicLimits:
         """The scaled planning limits for ``station``."""
