@@ -67,7 +67,7 @@ import yaml
 
 from ur3hanoi import __version__
 from ur3hanoi.errors import CalibrationError, TaughtPointsError
-from ur3hanoi.grid import ABOVE, ON, POSE_NAMES
+from ur3hanoi.grid import ABOVE, ON, POSE_NAMES, T_world_tcp
 from ur3hanoi.ik import wrap_angle
 from ur3hanoi.robot import N_JOINTS, load_ur3
 from ur3hanoi.station import Station, parse_station, station_to_dict
@@ -165,8 +165,7 @@ def parse_taught(data: Any, source: str = "<memory>", sha256: str = "") -> Taugh
     unknown_top = sorted(set(data) - {"units", "points"}, key=str)
     if unknown_top:
         raise _fail(source, f"unknown top-level key(s) {unknown_top}: expected 'units' and 'points'")
-    parsed: list[tuple[int, int, int, list[float]]] = []
-    labels: list[str] = []
+    raw: list[TaughtPoint] = []  # q still in `units`
     for i, item in enumerate(items):
         where = f"points[{i}]"
         if not isinstance(item, Mapping):
@@ -187,15 +186,11 @@ def parse_taught(data: Any, source: str = "<memory>", sha256: str = "") -> Taugh
         for j, v in enumerate(q):
             if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
                 raise _fail(source, f"{where}: q[{j}] = {v!r} is invalid: expected a finite number [{units}]")
-        k = POSE_NAMES.index(pose)
-        parsed.append((tower, height, k, [float(v) for v in q]))
-        labels.append(f"{where} (tower {tower} height {height} {pose})")
-    _check_units(source, [p[3] for p in parsed], units, labels)
+        raw.append(TaughtPoint(index=i, tower=tower, height=height, k=POSE_NAMES.index(pose),
+                               q=tuple(float(v) for v in q)))
+    _check_units(source, [p.q for p in raw], units, [p.label for p in raw])
     scale = math.pi / 180.0 if units == "deg" else 1.0
-    points = tuple(
-        TaughtPoint(index=i, tower=t, height=h, k=k, q=tuple(v * scale for v in q))
-        for i, (t, h, k, q) in enumerate(parsed)
-    )
+    points = tuple(replace(p, q=tuple(v * scale for v in p.q)) for p in raw)
     return TaughtPoints(points=points, source=source, sha256=sha256)
 
 
@@ -218,16 +213,11 @@ def taught_from_table(path: str | Path, key: str) -> TaughtPoints:
     """Every entry ``Q[t][h][k]`` [rad] of a lab-format table as a taught point (numbered in Q order)."""
     q = read_table(path, key)
     source = f"{path}:{key}"
-    flat = [q[t, h, k] for t in range(q.shape[0]) for h in range(q.shape[1]) for k in (ON, ABOVE)]
-    labels = [f"{source}[{t}][{h}][{k}]" for t in range(q.shape[0]) for h in range(q.shape[1]) for k in (ON, ABOVE)]
-    _check_units(source, [list(map(float, v)) for v in flat], "rad", labels)
-    points = []
-    for t in range(q.shape[0]):
-        for h in range(q.shape[1]):
-            for k in (ON, ABOVE):
-                points.append(TaughtPoint(index=len(points), tower=t, height=h, k=k,
-                                          q=tuple(float(v) for v in q[t, h, k])))
-    return TaughtPoints(points=tuple(points), source=source, sha256=hashlib.sha256(Path(path).read_bytes()).hexdigest())
+    slots = [(t, h, k) for t in range(q.shape[0]) for h in range(q.shape[1]) for k in (ON, ABOVE)]
+    points = tuple(TaughtPoint(index=i, tower=t, height=h, k=k, q=tuple(float(v) for v in q[t, h, k]))
+                   for i, (t, h, k) in enumerate(slots))
+    _check_units(source, [p.q for p in points], "rad", [f"{source}[{t}][{h}][{k}]" for t, h, k in slots])
+    return TaughtPoints(points=points, source=source, sha256=hashlib.sha256(Path(path).read_bytes()).hexdigest())
 
 
 # ------------------------------------------------------------------------------------------------------ fitting
@@ -427,8 +417,15 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
         raise _fail(where, f"the fitted approach height {approach:.4f} m is outside (0, 0.5] m: are some contact "
                            "poses marked 'pose: above' (or vice versa)?")
 
-    up = np.array([0.0, 0.0, 1.0])
-    fitted = np.array([origins[p.tower] + p.height * s + (approach if p.k == ABOVE else 0.0) * up for p in points])
+    try:
+        station = base.with_grid(origins, s, yaw, approach, source=source)
+    except CalibrationError as exc:
+        # Re-raised as a taught-points error: the base file is fine, the fitted geometry is not.
+        raise _fail(where, f"the fitted grid is invalid ({exc.allowed}; got {exc.field} = {exc.value}): "
+                           "check the tower/height labels of the taught points") from None
+
+    # The fitted grid's suction points, from the same grid model the tables are generated with.
+    fitted = np.array([T_world_tcp(station, p.tower, p.height, p.k).translation for p in points])
     residuals_mm = np.linalg.norm(measured - fitted, axis=1) * 1e3
     warnings = []
     for i, p in enumerate(points):
@@ -438,13 +435,6 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
         if abs(yaw_dev[i]) > YAW_WARN_DEG:
             warnings.append(f"{p.label}: tool heading {yaw_dev[i]:+.2f} deg from the fitted yaw "
                             f"{math.degrees(yaw):.2f} deg (> {YAW_WARN_DEG:g} deg)")
-
-    try:
-        station = base.with_grid(origins, s, yaw, approach, source=source)
-    except CalibrationError as exc:
-        # Re-raised as a taught-points error: the base file is fine, the fitted geometry is not.
-        raise _fail(where, f"the fitted grid is invalid ({exc.allowed}; got {exc.field} = {exc.value}): "
-                           "check the tower/height labels of the taught points") from None
     if name is not None:
         station = replace(station, name=name)
     params = ["tower_origins", "tool_yaw"]

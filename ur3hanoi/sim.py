@@ -24,6 +24,7 @@ Numbering: internally 0-based (towers, heights, blocks, moves); messages and JSO
 from __future__ import annotations
 
 import math
+import os
 import shutil
 import time
 from collections.abc import Callable, Sequence
@@ -41,10 +42,20 @@ from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.errors import SimulationError, SuctionFaultError, Ur3HanoiError
 from ur3hanoi.grid import block_center_world, table_z
-from ur3hanoi.hanoi import block_colour
+from ur3hanoi.hanoi import block_colour, solve_hanoi
 from ur3hanoi.plan import Phase, Plan, PlanConfig, Trajectory, plan_solve
-from ur3hanoi.robot import JOINT_NAMES, N_JOINTS, Q_HOME_LAB, T_BASELINK_BASE, ToolOffset, load_ur3, urdf_path
+from ur3hanoi.robot import (
+    JOINT_NAMES,
+    N_JOINTS,
+    Q_HOME_LAB,
+    T_BASELINK_BASE,
+    ToolOffset,
+    load_ur3,
+    package_dir,
+    urdf_path,
+)
 from ur3hanoi.station import Station
+from ur3hanoi.table import generate_table
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -85,7 +96,8 @@ DRIVES: dict[str, JointDrive] = {
     "size3": JointDrive(kp=2000.0, kv=100.0, armature=0.1, force_limit=56.0),
     "size1": JointDrive(kp=500.0, kv=12.0, armature=0.04, force_limit=12.0),
 }
-# Elbow torque limit is 28 N m (datasheet), the other size3 joints 56 N m.
+# Elbow torque limit is 28 N m (datasheet), the other size3 joints 56 N m: class size3_elbow overrides it.
+_ELBOW_FORCE_LIMIT = 28.0  # [N m]
 _JOINT_CLASS = {
     "shoulder_pan_joint": "size3",
     "shoulder_lift_joint": "size3",
@@ -232,7 +244,7 @@ def derive_ur3_mjcf(urdf: Path | None = None) -> str:
         return lines
 
     body = link_body("base_link", 2, None)
-    d3, de, d1 = DRIVES["size3"], 28.0, DRIVES["size1"]
+    d3, d1 = DRIVES["size3"], DRIVES["size1"]
     home = _vec(Q_HOME_LAB)
     actuators = [
         f'    <position name="{j.removesuffix("_joint")}" joint="{j}" class="{_JOINT_CLASS[j]}"/>' for j in JOINT_NAMES
@@ -255,7 +267,7 @@ def derive_ur3_mjcf(urdf: Path | None = None) -> str:
         f'        <joint armature="{_g(d3.armature)}"/>',
         f'        <position kp="{_g(d3.kp)}" kv="{_g(d3.kv)}" forcerange="{_range(d3.force_limit)}"/>',
         '        <default class="size3_elbow">',
-        f'          <position forcerange="{_g(-de)} {_g(de)}"/>',
+        f'          <position forcerange="{_range(_ELBOW_FORCE_LIMIT)}"/>',
         "        </default>",
         "      </default>",
         '      <default class="size1">',
@@ -298,14 +310,10 @@ def derive_ur3_mjcf(urdf: Path | None = None) -> str:
 
 def ur3_mesh_sources(urdf: Path | None = None) -> list[Path]:
     """The collision STL files ``ur3.xml`` uses, in the installed example-robot-data."""
-    path = urdf if urdf is not None else urdf_path()
-    root = ElementTree.parse(path).getroot()
-    share = path.parents[4]  # .../share/example-robot-data/robots/ur_description/urdf -> .../share
-    out = []
-    for mesh in root.findall("link/collision/geometry/mesh"):
-        uri = mesh.get("filename", "")
-        out.append(share / uri.removeprefix("package://"))
-    return out
+    root = ElementTree.parse(urdf if urdf is not None else urdf_path()).getroot()
+    share = package_dir()
+    return [share / mesh.get("filename", "").removeprefix("package://")
+            for mesh in root.findall("link/collision/geometry/mesh")]
 
 
 def write_ur3_files(out_dir: Path = ROBOT_DIR) -> list[Path]:
@@ -349,6 +357,12 @@ class SceneConfig:
     block_mass: float = 0.0225
     friction: float = 1.0
     weld_solref: tuple[float, float] = (0.01, 1.0)
+
+
+def _slot_centers(station: Station) -> FloatArray:
+    """Block centre of every slot, shape (n_towers, n_heights, 3) [m, world] (:func:`block_center_world`)."""
+    return np.array([[block_center_world(station, t, h) for h in range(station.n_heights)]
+                     for t in range(station.n_towers)])
 
 
 def block_name(block: int) -> str:
@@ -405,8 +419,8 @@ def build_task_spec(station: Station, start: int, n_blocks: int, removed: int | 
 
     # Table: a slab whose top is the grid's table surface, under the robot and every slot.
     tz = table_z(station)
-    pts = [np.asarray(station.base_xyz)[:2]]
-    pts += [block_center_world(station, t, h)[:2] for t in range(station.n_towers) for h in range(station.n_heights)]
+    centers = _slot_centers(station)
+    pts = np.vstack([np.asarray(station.base_xyz)[:2], centers[..., :2].reshape(-1, 2)])
     lo, hi = np.min(pts, axis=0) - 0.15, np.max(pts, axis=0) + 0.15
     spec.worldbody.add_geom(
         name="table", type=mujoco.mjtGeom.mjGEOM_BOX,
@@ -423,7 +437,7 @@ def build_task_spec(station: Station, start: int, n_blocks: int, removed: int | 
     eq_data[6] = 1.0  # identity relative quaternion; rewritten at run time before activation
     eq_data[10] = 1.0  # torquescale: the cup holds orientation as firmly as position
     for b, (t, h) in slots.items():
-        body = spec.worldbody.add_body(name=block_name(b), pos=block_center_world(station, t, h))
+        body = spec.worldbody.add_body(name=block_name(b), pos=centers[t, h])
         body.add_freejoint(name=f"{block_name(b)}_free")
         body.add_geom(
             name=f"{block_name(b)}_geom", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.5 * s] * 3,
@@ -440,8 +454,8 @@ def build_task_spec(station: Station, start: int, n_blocks: int, removed: int | 
     for key in list(spec.keys):
         spec.delete(key)
     qpos = list(station.q_home)
-    for b in slots:
-        qpos += [*block_center_world(station, *slots[b]), 1.0, 0.0, 0.0, 0.0]
+    for t, h in slots.values():
+        qpos += [*centers[t, h], 1.0, 0.0, 0.0, 0.0]
     spec.add_key(name="home", qpos=qpos, ctrl=list(station.q_home))
     return spec
 
@@ -554,10 +568,6 @@ class GripperInput:
         return bool(self.digin & 1)
 
 
-def _quat_conj(q: FloatArray) -> FloatArray:
-    return np.array([q[0], -q[1], -q[2], -q[3]])
-
-
 class SuctionCup:
     """Suction on/off, grasping by weld equality, drop injection and the ``gripper_input`` feedback."""
 
@@ -568,14 +578,16 @@ class SuctionCup:
         self.on = False
         self.attached: int | None = None
         self.grasp_enabled = True  # cleared while halting: a faulted cup must not pick anything up
+        st = scene.station
+        # Block centre -> suction point at contact; constant, and read every control cycle by held().
+        self._contact_offset = np.array([0.0, 0.0, 0.5 * st.block_size - st.contact_depth])
         m = scene.model
         for eq in scene.block_eq.values():
             m.eq_data[eq, 11] = 0.0  # use the relative pose written below, not one computed from qpos0
 
     def expected_suction_point(self, block: int) -> FloatArray:
         """Where the suction point sits at contact with ``block``: top-face centre minus contact_depth [m, world]."""
-        st = self.scene.station
-        return self.scene.block_pos(block) + np.array([0.0, 0.0, 0.5 * st.block_size - st.contact_depth])
+        return self.scene.block_pos(block) + self._contact_offset
 
     def command(self, on: bool) -> None:
         """Set the suction valve (``io_0``); turning it off releases any block."""
@@ -603,8 +615,9 @@ class SuctionCup:
         c, k = self.scene.cup_body, self.scene.block_body[block]
         R_c = d.xmat[c].reshape(3, 3)
         rel_pos = R_c.T @ (d.xpos[k] - d.xpos[c])
-        rel_quat = np.empty(4)
-        mujoco.mju_mulQuat(rel_quat, _quat_conj(d.xquat[c]), d.xquat[k])
+        conj_c, rel_quat = np.empty(4), np.empty(4)
+        mujoco.mju_negQuat(conj_c, d.xquat[c])
+        mujoco.mju_mulQuat(rel_quat, conj_c, d.xquat[k])
         eq = self.scene.block_eq[block]
         m.eq_data[eq, 0:3] = 0.0
         m.eq_data[eq, 3:6] = rel_pos
@@ -803,10 +816,11 @@ def _ruckig_samples(q0: FloatArray, v0: FloatArray, a0: FloatArray, station: Sta
     return qs, vs, accs
 
 
-def _slot_of(station: Station, xyz: FloatArray, tol: float) -> tuple[int, int] | None:
-    for t in range(station.n_towers):
-        for h in range(station.n_heights):
-            if np.linalg.norm(block_center_world(station, t, h) - xyz) <= tol:
+def _slot_of(centers: FloatArray, xyz: FloatArray, tol: float) -> tuple[int, int] | None:
+    """The first slot (tower, height) whose centre (``centers`` from :func:`_slot_centers`) is within ``tol``."""
+    for t, row in enumerate(centers):
+        for h, c in enumerate(row):
+            if np.linalg.norm(c - xyz) <= tol:
                 return t, h
     return None
 
@@ -886,7 +900,13 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
     drop_time: float | None = None
     n = len(tr.t)
     report_every = max(1, n // 50)
-    prev_phase = int(tr.phase[0])
+    # Per-sample flags as Python lists, computed once: the loop below is Python-bound (mj_step aside).
+    move_of, suction = tr.move_index.tolist(), tr.suction.tolist()
+    grasp, release = tr.phase == Phase.GRASP_DWELL, tr.phase == Phase.RELEASE_DWELL
+    dwell_ends = (grasp & ~np.append(grasp[1:], False)).tolist()  # last sample of each grasp dwell
+    completes = np.append(False, release[:-1] & ~release[1:]).tolist()  # first sample after a release dwell
+    carrying = np.isin(tr.phase, [p for p in Phase if p.carrying]).tolist()
+    arm_qadr = scene.arm_qadr
 
     trace: list[tuple[float, int, float]] = []  # (t [s], DIGIN, AIN0 [V]) every control cycle
 
@@ -917,9 +937,8 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
 
     k_fault = -1
     for k in range(1, n):
-        phase = int(tr.phase[k])
-        mv = int(tr.move_index[k])
-        want = bool(tr.suction[k])
+        mv = move_of[k]
+        want = suction[k]
         if want != cup.on:
             if not want and cup.attached is not None:
                 # Feedback as last read, i.e. just before the suction is switched off.
@@ -936,13 +955,13 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
             fb = step_cycle(ctrl[k], split_after=1, on_split=inject)
         else:
             fb = step_cycle(ctrl[k])
-        err = float(np.max(np.abs(d.qpos[scene.arm_qadr] - tr.q[k])))
-        max_err = max(max_err, err)
-        if prev_phase == Phase.RELEASE_DWELL and phase != Phase.RELEASE_DWELL:
+        err = np.abs(d.qpos[arm_qadr] - tr.q[k]).max()
+        if err > max_err:
+            max_err = float(err)
+        if completes[k]:
             moves_completed += 1
-        dwell_end = phase == Phase.GRASP_DWELL and (k == n - 1 or int(tr.phase[k + 1]) != Phase.GRASP_DWELL)
-        carrying = Phase(phase).carrying
-        if (dwell_end or carrying) and not fb.held:
+        dwell_end = dwell_ends[k]
+        if (dwell_end or carrying[k]) and not fb.held:
             move = moves[mv]
             kind = "missing" if dwell_end else "dropped"
             events.append(FeedbackEvent(fb.t, kind, mv, move.block, fb.digin, fb.ain0))
@@ -957,7 +976,6 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
         if dwell_end:
             events.append(FeedbackEvent(fb.t, "grasp", mv, cup.attached if cup.attached is not None else -1,
                                         fb.digin, fb.ain0))
-        prev_phase = phase
         if progress is not None and k % report_every == 0:
             progress(k / (n - 1), f"move {max(mv, 0) + 1}/{len(moves)}")
 
@@ -992,9 +1010,10 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
 
     # Verify from the simulation state.
     final = []
+    centers = _slot_centers(st)
     for b in sorted(scene.block_body):
         xyz = scene.block_pos(b)
-        slot = _slot_of(st, xyz, cfg.place_tolerance)
+        slot = _slot_of(centers, xyz, cfg.place_tolerance)
         final.append(FinalBlock(b, None if slot is None else slot[0], None if slot is None else slot[1],
                                 (float(xyz[0]), float(xyz[1]), float(xyz[2]))))
     at_home = bool(np.max(np.abs(scene.arm_q() - st.q_home_array)) <= cfg.home_tolerance)
@@ -1048,7 +1067,7 @@ class CameraConfig:
 def _free_camera(station: Station, cam: CameraConfig) -> mujoco.MjvCamera:
     c = mujoco.MjvCamera()
     c.type = mujoco.mjtCamera.mjCAMERA_FREE
-    pts = [block_center_world(station, t, h) for t in range(station.n_towers) for h in range(station.n_heights)]
+    pts = _slot_centers(station).reshape(-1, 3)
     c.lookat[:] = 0.5 * (np.mean(pts, axis=0) + np.asarray(station.base_xyz)) + np.array([0.0, 0.0, 0.1])
     c.distance, c.azimuth, c.elevation = cam.distance, cam.azimuth, cam.elevation
     return c
@@ -1122,8 +1141,6 @@ class OffscreenRecorder:
 
 def display_available() -> str | None:
     """None when an interactive viewer can open, else the reason it cannot."""
-    import os
-
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         return "no display (DISPLAY and WAYLAND_DISPLAY are unset); use --video FILE.mp4 or --frames DIR"
     return None
@@ -1177,12 +1194,9 @@ def _quintic_segment(q0: FloatArray, q1: FloatArray, station: Station, speed: fl
 def simple_plan(station: Station, start: int, end: int, n_blocks: int, config: PlanConfig | None = None) -> Plan:
     """A stop-and-go plan (quintic joint segments through the IK table's waypoints) with the contract's labels.
 
-    A stand-in for :func:`ur3hanoi.plan.plan_solve` (used when that is unavailable, and by tests that need a
-    plan independent of the planner).
+    Not used by the CLI (:func:`make_plan` is the planner's plan): kept for tests and experiments that need a
+    plan independent of :func:`ur3hanoi.plan.plan_solve`.
     """
-    from ur3hanoi.hanoi import solve_hanoi
-    from ur3hanoi.table import generate_table
-
     cfg = config if config is not None else PlanConfig()
     moves = tuple(solve_hanoi(n_blocks, start, end, station.n_towers, station.n_heights))
     Q = generate_table(station).q
@@ -1230,8 +1244,8 @@ def simple_plan(station: Station, start: int, end: int, n_blocks: int, config: P
 
 
 def make_plan(station: Station, start: int, end: int, n_blocks: int, config: PlanConfig | None = None) -> Plan:
-    """The planner's plan (:func:`ur3hanoi.plan.plan_solve`) for a solve."""
-    return plan_solve(station, start, end, n_blocks, config if config is not None else PlanConfig())
+    """The planner's plan (:func:`ur3hanoi.plan.plan_solve`) for a solve (``config`` None: the defaults)."""
+    return plan_solve(station, start, end, n_blocks, config)
 
 
 @dataclass(frozen=True)
