@@ -183,3 +183,16 @@ def test_calibration_files_untouched_by_generation(tmp_path: Path) -> None:
         before = copy.read_bytes()
         assert main(["tables", str(copy), "--key", "real_pos", "-o", str(tmp_path / "o.yaml")]) == 0
         assert copy.read_bytes() == before
+
+
+def test_new_file_gets_umask_permissions_existing_keeps_its_own(lab_real: Station, tmp_path: Path) -> None:
+    umask = os.umask(0o022)
+    try:
+        out = tmp_path / "new.yaml"
+        write_table(out, generate_table(lab_real), "real_pos")
+        assert out.stat().st_mode & 0o777 == 0o644
+        out.chmod(0o600)
+        write_table(out, generate_table(lab_real), "real_pos")
+        assert out.stat().st_mode & 0o777 == 0o600
+    finally:
+        os.umask(umask)

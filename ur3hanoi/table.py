@@ -235,6 +235,10 @@ def atomic_write(path: str | Path, text: str) -> None:
             os.fsync(f.fileno())
         if p.exists():
             os.chmod(tmp, p.stat().st_mode & 0o777)
+        else:  # mkstemp creates 0600; a new file gets the usual permissions (0666 less the umask)
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, p)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
