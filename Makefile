@@ -25,8 +25,8 @@ test: $(STAMP)
 
 # Regenerate the shipped waypoint table from the two shipped calibrations (a test fails when it is stale).
 tables: $(STAMP)
-	$(VENV)/bin/ur3hanoi tables robots/stations/lab_sim.yaml --key sim_pos -o tables/lab2_data.yaml
-	$(VENV)/bin/ur3hanoi tables robots/stations/lab_real.yaml --key real_pos -o tables/lab2_data.yaml
+	$(VENV)/bin/ur3hanoi tables lab_sim --key sim_pos -o tables/lab2_data.yaml
+	$(VENV)/bin/ur3hanoi tables lab_real --key real_pos -o tables/lab2_data.yaml
 
 docs: $(STAMP)
 	$(VENV)/bin/python tools/update_readme_cli.py

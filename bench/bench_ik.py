@@ -16,6 +16,7 @@ import numpy as np
 
 from ur3hanoi.grid import T_base_tcp
 from ur3hanoi.ik import SOLVERS, branch_of, make_solver, solve_on_branch
+from ur3hanoi.resources import stations_dir
 from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import load_station
 
@@ -47,7 +48,7 @@ def bench_cli(repeats: int = 5) -> float:
     with tempfile.TemporaryDirectory() as tmp:
         for _ in range(repeats):
             t0 = time.perf_counter()
-            subprocess.run([sys.executable, "-m", "ur3hanoi.cli", "tables", "robots/stations/lab_sim.yaml",
+            subprocess.run([sys.executable, "-m", "ur3hanoi.cli", "tables", "lab_sim",
                             "--key", "sim_pos", "-o", f"{tmp}/lab2_data.yaml"], cwd=REPO, check=True,
                            capture_output=True)
             walls.append(time.perf_counter() - t0)
@@ -58,7 +59,7 @@ def main() -> dict[str, object]:
     results: dict[str, object] = {}
     for station in ("lab_sim", "lab_real"):
         for name in SOLVERS:
-            r = bench_solver(name, REPO / f"robots/stations/{station}.yaml")
+            r = bench_solver(name, stations_dir() / f"{station}.yaml")
             results[f"ik_{name}_{station}"] = r
             print(f"IK {name:9s} {station:8s}: {r['us_per_pose']:7.1f} us/pose, {r['ms_per_table']:.2f} ms per "
                   f"{r['poses']}-pose table (target < 5 ms)")

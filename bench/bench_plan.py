@@ -18,6 +18,7 @@ import time
 from pathlib import Path
 
 from ur3hanoi.plan import PlanConfig, build_waypoints, plan_solve
+from ur3hanoi.resources import stations_dir
 from ur3hanoi.station import load_station
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -25,7 +26,7 @@ TARGET_MS_PER_MOVE = 2.0
 
 
 def main() -> None:
-    real = load_station(ROOT / "robots/stations/lab_real.yaml")
+    real = load_station(stations_dir() / "lab_real.yaml")
     # Tall synthetic grid: lab_real with 10 levels; towers moved closer to the base so the top levels stay reachable.
     tall = dataclasses.replace(real, n_heights=10, tower_origins=tuple((0.22, y, z) for _, y, z in real.tower_origins))
     t0 = time.perf_counter()
@@ -56,7 +57,7 @@ def main() -> None:
     print(f"worst plan time per move: {worst:.3f} ms ({'within' if worst < TARGET_MS_PER_MOVE else 'OVER'} the "
           f"{TARGET_MS_PER_MOVE:g} ms target)")
     for name in ("lab_sim", "lab_real"):
-        st = load_station(ROOT / f"robots/stations/{name}.yaml")
+        st = load_station(stations_dir() / f"{name}.yaml")
         plan_solve(st, 0, 2, 1)  # warm the waypoint cache
         runs = [plan_solve(st, 0, 2, 3) for _ in range(5)]  # with clearance checks, as the CLI plans
         plan = min(runs, key=lambda p: p.timings_s["build"] + p.timings_s["sampling"])

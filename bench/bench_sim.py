@@ -18,6 +18,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from ur3hanoi.resources import stations_dir  # noqa: E402
 from ur3hanoi.sim import make_plan, run_plan  # noqa: E402
 from ur3hanoi.station import load_station  # noqa: E402
 
@@ -27,7 +28,7 @@ def main() -> int:
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
     for name in ("lab_sim", "lab_real"):
-        st = load_station(REPO / f"robots/stations/{name}.yaml")
+        st = load_station(stations_dir() / f"{name}.yaml")
         t0 = time.perf_counter()
         plan = make_plan(st, 0, 2, 3)
         t_plan = time.perf_counter() - t0

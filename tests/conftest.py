@@ -6,11 +6,12 @@ from pathlib import Path
 
 import pytest
 
+from ur3hanoi.resources import stations_dir
 from ur3hanoi.station import Station, load_station
 
 REPO = Path(__file__).resolve().parents[1]
-LAB_SIM = REPO / "robots/stations/lab_sim.yaml"
-LAB_REAL = REPO / "robots/stations/lab_real.yaml"
+LAB_SIM = stations_dir() / "lab_sim.yaml"
+LAB_REAL = stations_dir() / "lab_real.yaml"
 STATION_FILES = {"lab_sim": LAB_SIM, "lab_real": LAB_REAL}
 
 

@@ -17,10 +17,11 @@ from ur3hanoi.cli import main
 from ur3hanoi.errors import PlanError, PuzzleError
 from ur3hanoi.grid import ABOVE, ON
 from ur3hanoi.plan import Phase, Plan, PlanConfig, build_waypoints, check_vertical, plan_solve
+from ur3hanoi.resources import stations_dir
 from ur3hanoi.station import Station, load_station
 
 ROOT = Path(__file__).resolve().parents[1]
-STATIONS = {name: ROOT / "robots/stations" / f"{name}.yaml" for name in ("lab_sim", "lab_real")}
+STATIONS = {name: stations_dir() / f"{name}.yaml" for name in ("lab_sim", "lab_real")}
 PAIRS = list(itertools.permutations(range(3), 2))
 
 

@@ -19,6 +19,7 @@ from ur3hanoi import cli
 from ur3hanoi.grid import block_center_world
 from ur3hanoi.hanoi import solve_hanoi
 from ur3hanoi.plan import Phase
+from ur3hanoi.resources import stations_dir
 from ur3hanoi.robot import JOINT_NAMES, Q_HOME_LAB, load_ur3
 from ur3hanoi.sim import (
     SCENE_XML,
@@ -39,7 +40,7 @@ from ur3hanoi.station import load_station
 from ur3hanoi.table import generate_table
 
 REPO = Path(__file__).resolve().parents[1]
-STATIONS = {name: load_station(REPO / f"robots/stations/{name}.yaml") for name in ("lab_sim", "lab_real")}
+STATIONS = {name: load_station(stations_dir() / f"{name}.yaml") for name in ("lab_sim", "lab_real")}
 PAIRS = list(itertools.permutations(range(3), 2))
 MAX_TRACKING_RAD = math.radians(0.5)
 
@@ -67,7 +68,7 @@ def solved(plans) -> dict[tuple[str, int, int], SimResult]:
 
 
 def test_ur3_xml_is_up_to_date_with_the_urdf() -> None:
-    assert UR3_XML.read_text() == derive_ur3_mjcf(), "run: .venv/bin/python robots/ur3/derive.py"
+    assert UR3_XML.read_text() == derive_ur3_mjcf(), "run: python -m ur3hanoi.sim"
     for src in ur3_mesh_sources():
         assert (UR3_XML.parent / "assets" / src.name).read_bytes() == src.read_bytes()
 

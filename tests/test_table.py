@@ -33,8 +33,8 @@ notes: {station: 4, by: "TA"}
 
 def _regenerate(out: Path) -> None:
     """The exact commands that produce tables/lab2_data.yaml (see the Makefile's `tables` target)."""
-    assert main(["tables", "robots/stations/lab_sim.yaml", "--key", "sim_pos", "-o", str(out)]) == 0
-    assert main(["tables", "robots/stations/lab_real.yaml", "--key", "real_pos", "-o", str(out)]) == 0
+    assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(out)]) == 0
+    assert main(["tables", "lab_real", "--key", "real_pos", "-o", str(out)]) == 0
 
 
 def test_shipped_table_is_not_stale(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -2,12 +2,12 @@
 
 Workflow::
 
-    ur3hanoi calibrate --taught my_taught.yaml --base robots/stations/lab_real.yaml -o my_station.yaml
+    ur3hanoi calibrate --taught my_taught.yaml --base lab_real -o my_station.yaml
     ur3hanoi tables my_station.yaml --key real_pos -o lab2_data.yaml
 
 or, from an existing (e.g. hand-recorded) lab-format table, every entry ``Q[t][h][k]`` used as a taught point::
 
-    ur3hanoi calibrate --from-table lab2_data.yaml --key real_pos --base robots/stations/lab_real.yaml -o out.yaml
+    ur3hanoi calibrate --from-table lab2_data.yaml --key real_pos --base lab_real -o out.yaml
 
 Taught-points file (tower and height are 0-based, like ``Q[tower][height]`` of ``lab2_data.yaml``)::
 
@@ -62,18 +62,16 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 import yaml
 
 from ur3hanoi import __version__
+from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import CalibrationError, TaughtPointsError
 from ur3hanoi.grid import ABOVE, ON, POSE_NAMES, T_world_tcp
 from ur3hanoi.ik import wrap_angle
 from ur3hanoi.robot import N_JOINTS, load_ur3
 from ur3hanoi.station import Station, parse_station, station_to_dict
 from ur3hanoi.table import atomic_write, read_table
-
-FloatArray = npt.NDArray[np.float64]
 
 UNITS: tuple[str, ...] = ("deg", "rad")
 RESIDUAL_WARN_MM = 2.0  # [mm] a point farther than this from the fitted grid is probably mis-recorded

@@ -14,7 +14,7 @@ from pathlib import Path
 from ur3hanoi import __version__
 from ur3hanoi.errors import Ur3HanoiError
 
-DEFAULT_CALIBRATION = "robots/stations/lab_sim.yaml"
+DEFAULT_CALIBRATION = "lab_sim"
 
 
 def _positive_float(text: str) -> float:
@@ -34,7 +34,7 @@ def _add_tables(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("tables", help="generate a lab2_data.yaml waypoint table from a calibration by IK",
                        description="Generate Q[tower][height][0 = on, 1 = above] (6 joint angles [rad]) by IK "
                                    "and write it under --key into FILE, keeping every other key of FILE.")
-    p.add_argument("calibration", help="station calibration YAML (e.g. robots/stations/lab_sim.yaml)")
+    p.add_argument("calibration", help="station calibration YAML, or a shipped station name (lab_sim, lab_real)")
     p.add_argument("--key", required=True, choices=["sim_pos", "real_pos"], help="table key to (re)generate")
     p.add_argument("-o", "--output", required=True, metavar="FILE", help="lab-format YAML file to create/update")
     p.add_argument("--solver", default="pinocchio", choices=["pinocchio", "placo"], help="IK solver")
@@ -179,12 +179,9 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_run_solve)
 
 
-def _calibration_path(arg: str | None) -> Path:
-    """``--calibration``, or the default resolved against the repository when the cwd lacks it."""
-    if arg is not None:
-        return Path(arg)
-    path = Path(DEFAULT_CALIBRATION)
-    return path if path.exists() else Path(__file__).resolve().parents[1] / DEFAULT_CALIBRATION
+def _calibration_path(arg: str | None) -> str:
+    """``--calibration`` (a file or a shipped station name), or the shipped default station."""
+    return DEFAULT_CALIBRATION if arg is None else arg
 
 
 def _solve_prompt_tower(what: str, n_towers: int, exclude: int | None = None) -> int:

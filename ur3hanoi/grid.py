@@ -9,13 +9,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import numpy.typing as npt
 import pinocchio as pin
 
+from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
 from ur3hanoi.station import Station
-
-FloatArray = npt.NDArray[np.float64]
 
 ON, ABOVE = 0, 1
 POSE_NAMES: tuple[str, str] = ("on", "above")

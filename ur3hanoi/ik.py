@@ -16,13 +16,12 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
-import numpy.typing as npt
 import pinocchio as pin
 
+from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import IKError, Ur3HanoiError
 from ur3hanoi.robot import DH_A, DH_D, T_BASELINK_BASE, JointLimits, Ur3Model, dh_fk, dh_link
 
-FloatArray = npt.NDArray[np.float64]
 Branch = tuple[int, int, int]
 
 POSITION_TOL = 1e-9  # [m] required accuracy of every table pose

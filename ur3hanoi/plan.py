@@ -54,6 +54,7 @@ import pinocchio as pin
 from ruckig import InputParameter, Result, Ruckig
 from ruckig import Trajectory as RuckigTrajectory
 
+from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
 from ur3hanoi.grid import ABOVE, ON, R_world_tcp_down, T_base_tcp, block_center_world, contact_point_world, table_z
 from ur3hanoi.hanoi import Move, check_sequence, solve_hanoi, stacks_before_moves
@@ -61,8 +62,6 @@ from ur3hanoi.ik import analytic_ik, branch_of, nearest_equivalent
 from ur3hanoi.robot import N_JOINTS, T_BASELINK_BASE, Ur3Model, dh_fk, load_ur3
 from ur3hanoi.station import Station
 from ur3hanoi.table import generate_table
-
-FloatArray = npt.NDArray[np.float64]
 
 LIMIT_RTOL = 1e-6  # relative tolerance of the velocity/acceleration/jerk checks
 POSITION_ATOL = 1e-9  # [rad] slack of the joint position limit check

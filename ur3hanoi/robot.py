@@ -23,12 +23,10 @@ from functools import cache
 from pathlib import Path
 
 import numpy as np
-import numpy.typing as npt
 import pinocchio as pin
 
+from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
-
-FloatArray = npt.NDArray[np.float64]
 
 JOINT_NAMES: tuple[str, ...] = (
     "shoulder_pan_joint",

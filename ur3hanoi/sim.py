@@ -2,11 +2,11 @@
 
 Pieces, in order of use:
 
-- :func:`derive_ur3_mjcf` regenerates ``robots/ur3/ur3.xml`` from example-robot-data's ``ur3_robot.urdf``
-  (``robots/ur3/derive.py`` writes it; a test checks the committed file is up to date).
+- :func:`derive_ur3_mjcf` regenerates ``robots/universal_robots_ur3/ur3.xml`` from example-robot-data's
+  ``ur3_robot.urdf`` (``python -m ur3hanoi.sim`` writes it; a test checks the committed file is up to date).
 - :func:`build_task_spec` / :func:`build_task_scene` build the station's task scene with :class:`mujoco.MjSpec`:
-  ``robots/ur3/scene.xml`` (robot, floor, light) + the robot placed at the calibration's base pose, a table,
-  and the blocks (green/yellow/red bottom to top) on a start tower, optionally with one block removed.
+  ``robots/universal_robots_ur3/scene.xml`` (robot, floor, light) + the robot placed at the calibration's base
+  pose, a table, and the blocks (green/yellow/red bottom to top) on a start tower, optionally with one block removed.
 - :class:`SuctionCup` emulates the lab's vacuum gripper: a weld equality per block, switched on when the suction
   is on and the suction point is close to where it would be at contact; :class:`GripperInput` is the emulated
   ``ur3/gripper_input`` feedback (``DIGIN`` bit 0 = block held, ``AIN0`` [V]).
@@ -40,10 +40,12 @@ import pinocchio as pin
 from ruckig import ControlInterface, InputParameter, Result, Ruckig
 from ruckig import Trajectory as RuckigTrajectory
 
+from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import SimulationError, SuctionFaultError, Ur3HanoiError
 from ur3hanoi.grid import block_center_world, table_z
 from ur3hanoi.hanoi import block_colour, solve_hanoi
 from ur3hanoi.plan import Phase, Plan, PlanConfig, Trajectory, plan_solve
+from ur3hanoi.resources import robot_dir
 from ur3hanoi.robot import (
     JOINT_NAMES,
     N_JOINTS,
@@ -57,9 +59,7 @@ from ur3hanoi.robot import (
 from ur3hanoi.station import Station
 from ur3hanoi.table import generate_table
 
-FloatArray = npt.NDArray[np.float64]
-
-ROBOT_DIR = Path(__file__).resolve().parents[1] / "robots" / "ur3"
+ROBOT_DIR = robot_dir()
 UR3_XML = ROBOT_DIR / "ur3.xml"
 SCENE_XML = ROBOT_DIR / "scene.xml"
 SOURCE_PACKAGE = "example-robot-data 4.4.0"
@@ -169,12 +169,12 @@ def _ee_T_tcp(tool: ToolOffset) -> pin.SE3:
 
 
 def derive_ur3_mjcf(urdf: Path | None = None) -> str:
-    """The text of ``robots/ur3/ur3.xml``, derived deterministically from ``ur3_robot.urdf``.
+    """The text of ``robots/universal_robots_ur3/ur3.xml``, derived deterministically from ``ur3_robot.urdf``.
 
-    Changes from the URDF (see ``robots/ur3/README.md``): visual ``.dae`` meshes dropped and the collision STLs used
-    as visuals too; ``ee_link``'s 1 cm collision box replaced by a non-colliding suction cup body with the
-    ``suction`` site (lab_sim tool by default); the ``world`` link dropped (``base_link`` is the root body);
-    armature, position actuators with datasheet torque limits, gravity compensation on the moving links, the
+    Changes from the URDF (see ``robots/universal_robots_ur3/README.md``): visual ``.dae`` meshes dropped and the
+    collision STLs used as visuals too; ``ee_link``'s 1 cm collision box replaced by a non-colliding suction cup
+    body with the ``suction`` site (lab_sim tool by default); the ``world`` link dropped (``base_link`` is the root
+    body); armature, position actuators with datasheet torque limits, gravity compensation on the moving links, the
     ``base_link``/``shoulder_link`` contact excluded, a ``home`` keyframe.
     """
     path = urdf if urdf is not None else urdf_path()
@@ -317,7 +317,7 @@ def ur3_mesh_sources(urdf: Path | None = None) -> list[Path]:
 
 
 def write_ur3_files(out_dir: Path = ROBOT_DIR) -> list[Path]:
-    """Regenerate ``ur3.xml`` and copy the STL meshes into ``assets/`` (what ``robots/ur3/derive.py`` runs)."""
+    """Regenerate ``ur3.xml`` and copy the STL meshes into ``assets/`` (what ``python -m ur3hanoi.sim`` runs)."""
     assets = out_dir / "assets"
     assets.mkdir(parents=True, exist_ok=True)
     written = []
@@ -396,7 +396,7 @@ def build_task_spec(station: Station, start: int, n_blocks: int, removed: int | 
     """
     cfg = config if config is not None else SceneConfig()
     if not SCENE_XML.is_file():
-        raise SimulationError(f"{SCENE_XML} is missing: run robots/ur3/derive.py")
+        raise SimulationError(f"{SCENE_XML} is missing: run python -m ur3hanoi.sim")
     spec = mujoco.MjSpec.from_file(str(SCENE_XML))
     spec.option.timestep = cfg.timestep
     if cfg.timestep > 0.002 + 1e-12:

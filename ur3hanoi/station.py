@@ -2,7 +2,7 @@
 
 A station is the robot's base pose in the world, the suction tool offset, the block size and the tower grid.
 Every pose is in the **world** frame of the station (z up, table surface horizontal) unless its name says
-otherwise. See ``robots/stations/README.md`` for the file reference.
+otherwise. See ``ur3hanoi/stations/README.md`` for the file reference.
 
 Example (the course's flat Gazebo layout)::
 
@@ -40,14 +40,14 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-import numpy.typing as npt
 import pinocchio as pin
 import yaml
 
+from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import CalibrationError
+from ur3hanoi.resources import station_file, station_names
 from ur3hanoi.robot import FLANGE_FRAMES, N_JOINTS, JointLimits, ToolOffset
 
-FloatArray = npt.NDArray[np.float64]
 Vec3 = tuple[float, float, float]
 Layout = Literal["flat", "stacked"]
 LAYOUTS: tuple[str, ...] = ("flat", "stacked")
@@ -202,18 +202,20 @@ class _Reader:
 
 
 def load_station(path: str | Path) -> Station:
-    """Read and validate a station calibration file.
+    """Read and validate a station calibration file, or a shipped station by name (``lab_sim``, ``lab_real``).
 
     Raises:
         CalibrationError: the file is missing or unreadable, or a field is missing or out of range; the message
             names the file, the field, the bad value and what is allowed.
     """
-    p = Path(path)
+    p = station_file(path)
     source = str(path)
     try:
         raw = p.read_bytes()
     except OSError as exc:
-        raise CalibrationError(source, "<file>", str(p), f"a readable calibration file ({exc.strerror})") from None
+        names = ", ".join(station_names())
+        raise CalibrationError(source, "<file>", str(p), f"a readable calibration file ({exc.strerror}) or a "
+                               f"shipped station name ({names})") from None
     try:
         data = yaml.safe_load(raw)
     except yaml.YAMLError as exc:

@@ -20,17 +20,16 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 import yaml
 
 from ur3hanoi import __version__
+from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import TableError
 from ur3hanoi.grid import POSE_NAMES, T_base_tcp, T_world_tcp, block_xy_pos
 from ur3hanoi.ik import IKResult, IKSolver, branch_of, make_solver, pose_errors, solve_on_branch
 from ur3hanoi.robot import N_JOINTS, load_ur3
 from ur3hanoi.station import Station
 
-FloatArray = npt.NDArray[np.float64]
 TABLE_KEYS: tuple[str, ...] = ("sim_pos", "real_pos")
 BLOCK_XY_KEY = "block_xy_pos"
 
