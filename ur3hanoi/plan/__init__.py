@@ -19,7 +19,8 @@ Module map (dependencies flow downward only):
   ``Trajectory.at_time`` that samples the whole plan at ``rate_hz``.
 - :mod:`~ur3hanoi.plan.checks`: :func:`check_limits` and :func:`check_vertical` (the 2 mm vertical line).
 - :mod:`~ur3hanoi.plan.collision`: :class:`CollisionScene` and :func:`check_collisions` (clearances).
-- :mod:`~ur3hanoi.plan.export`: :func:`trajectory_csv` and :func:`plan_json_dict` (``ur3hanoi plan`` output).
+- :mod:`~ur3hanoi.plan.export`: :func:`trajectory_csv` and the JSON summary behind :meth:`Plan.to_json_dict`
+  (what ``ur3hanoi plan`` prints).
 - :mod:`~ur3hanoi.plan.planner`: :func:`plan_moves` / :func:`plan_solve`: waypoints -> segments -> samples ->
   checks -> :class:`Plan`.
 
@@ -41,7 +42,7 @@ clearances by :func:`check_collisions`.
 
 from ur3hanoi.plan.checks import check_limits, check_vertical, tcp_positions_world
 from ur3hanoi.plan.collision import CollisionScene, check_collisions
-from ur3hanoi.plan.export import plan_json_dict, trajectory_csv
+from ur3hanoi.plan.export import trajectory_csv
 from ur3hanoi.plan.planner import plan_moves, plan_solve
 from ur3hanoi.plan.ruckig import OfflineRuckig, RuckigSolution, control_samples, to_pose, to_rest
 from ur3hanoi.plan.sampling import sample
@@ -81,7 +82,6 @@ __all__ = [
     "check_limits",
     "check_vertical",
     "control_samples",
-    "plan_json_dict",
     "plan_moves",
     "plan_solve",
     "sample",
