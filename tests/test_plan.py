@@ -1,4 +1,6 @@
-"""Ruckig motion plans: limits, endpoints, vertical approach, pass-through vs stop-and-go, clearances, CLI."""
+"""Planning a solve (ur3hanoi.plan.planner): limits, endpoints, vertical approach, pass-through vs stop-and-go, CLI.
+
+The modules of the plan subpackage have their own test files (tests/test_plan_<module>.py)."""
 
 from __future__ import annotations
 
@@ -123,15 +125,6 @@ def test_puzzle_errors(stations: dict[str, Station]) -> None:
         plan_solve(stations["lab_sim"], 0, 3, 2)
 
 
-def test_clearance_check_detects(stations: dict[str, Station]) -> None:
-    """An impossible 20 cm block clearance must be reported (the check is live)."""
-    cfg = PlanConfig(clearance_m=0.2, raise_on_violation=False)
-    plan = plan_solve(stations["lab_real"], 0, 2, 2, cfg)
-    assert any("carried_block" in v for v in plan.violations)
-    with pytest.raises(PlanError, match="carried_block"):
-        plan_solve(stations["lab_real"], 0, 2, 2, dataclasses.replace(cfg, raise_on_violation=True))
-
-
 def test_rate_500(stations: dict[str, Station]) -> None:
     plan = plan_solve(stations["lab_sim"], 0, 1, 2, PlanConfig(rate_hz=500, check_collisions=False))
     np.testing.assert_allclose(np.diff(plan.trajectory.t), 1 / 500)
@@ -176,89 +169,6 @@ def test_cli_json_and_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
         rows = list(csv.reader(f))
     assert rows[0] == ["t", *(f"q{i}" for i in range(1, 7)), *(f"qd{i}" for i in range(1, 7)), "suction"]
     assert {r[-1] for r in rows[1:]} == {"0", "1"}
-
-
-# ------------------------------------------------------------------------------------------------- sampling
-
-
-def test_sampling_matches_ruckig_at_time(plans: dict[tuple[str, int, int, int], Plan]) -> None:
-    """The vectorized sampler equals Ruckig's own at_time (joints) / at_time + path map (vertical legs)."""
-    plan = plans[("lab_real", 0, 2, 3)]
-    tr = plan.trajectory
-    rng = np.random.default_rng(0)
-    for k in rng.choice(len(tr.t) - 1, 300, replace=False):
-        seg = next(s for s in reversed(plan.segments) if s.t_start <= tr.t[k])
-        if seg.trajectory is None:
-            np.testing.assert_array_equal(tr.q[k], seg.q_start)
-            continue
-        x, xd, xdd = (np.array(v) for v in seg.trajectory.at_time(min(tr.t[k] - seg.t_start, seg.duration)))
-        if seg.path is not None:
-            q, d1, d2, _ = seg.path.evaluate(x[0])
-            x, xd, xdd = q, d1 * xd[0], d2 * xd[0] ** 2 + d1 * xdd[0]
-        np.testing.assert_allclose(tr.q[k], x, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(tr.qd[k], xd, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(tr.qdd[k], xdd, rtol=0, atol=1e-11)
-
-
-def test_sampling_brake_profile_fallback() -> None:
-    """A start above the velocity limit gives Ruckig a brake pre-profile; sampling still equals at_time."""
-    from ruckig import InputParameter, Ruckig
-    from ruckig import Trajectory as RuckigTrajectory
-
-    from ur3hanoi.plan import Segment, sample
-
-    inp = InputParameter(6)
-    inp.current_position, inp.target_position = [0.0] * 6, [0.5, -0.3, 0.2, 0.1, 0.0, -0.4]
-    inp.current_velocity = [1.5, 0.0, 0.0, 0.0, 0.0, 0.0]  # above max_velocity: brake first
-    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [1.0] * 6, [2.0] * 6, [10.0] * 6
-    traj = RuckigTrajectory(6)
-    Ruckig(6).calculate(inp, traj)
-    assert traj.profiles[0][0].brake.duration > 0
-    z = np.zeros(6)
-    seg = Segment(Phase.TRANSIT, 0, 0.0, traj.duration, z, np.array(inp.target_position), z, z, "x", traj)
-    tr = sample([seg], 125.0)
-    for k in range(len(tr.t) - 1):
-        x, xd, xdd = (np.array(v) for v in traj.at_time(tr.t[k]))
-        np.testing.assert_array_equal(tr.q[k], x)
-        np.testing.assert_array_equal(tr.qd[k], xd)
-        np.testing.assert_array_equal(tr.qdd[k], xdd)
-
-
-def test_batched_fk_matches_pinocchio(stations: dict[str, Station]) -> None:
-    from ur3hanoi.plan import _tcp_positions_world
-    from ur3hanoi.robot import load_ur3
-
-    st_ = stations["lab_real"]
-    robot = load_ur3(st_.tool, st_.limits)
-    q = np.random.default_rng(1).uniform(-3.0, 3.0, (50, 6))
-    expected = np.array([(st_.T_world_base * robot.fk(qi, "tcp")).translation for qi in q])
-    np.testing.assert_allclose(_tcp_positions_world(st_, q), expected, rtol=0, atol=1e-10)
-
-
-def test_via_descent_finds_grid_optimum(stations: dict[str, Station]) -> None:
-    """The descent over via-speed candidates picks the optimum of the full candidate grid on every connection."""
-    from ur3hanoi.hanoi import solve_hanoi
-    from ur3hanoi.plan import _AT_REST, _Builder
-
-    for name, (s, e) in itertools.product(STATIONS, [(0, 2), (2, 1)]):
-        st_ = stations[name]
-        b = _Builder(st_, build_waypoints(st_), PlanConfig())
-        b.build(solve_hanoi(3, s, e, st_.n_towers, st_.n_heights))
-        for (slot0, q0b, slot1, q1b), (s0, s1, traj) in b._horizontal_memo.items():
-            q0, q1 = np.frombuffer(q0b), np.frombuffer(q1b)
-            c0 = b.legs(slot0) if slot0 is not None else _AT_REST
-            c1 = b.legs(slot1) if slot1 is not None else _AT_REST
-            legs0 = [c0.get(i) for i in range(c0.count())]
-            legs1 = [c1.get(j) for j in range(c1.count())]
-            chosen = next(l0.duration for l0 in legs0 if l0 and l0.sigma == s0) + traj.duration + next(
-                l1.duration for l1 in legs1 if l1 and l1.sigma == s1)
-            best = np.inf
-            for l0, l1 in itertools.product(legs0, legs1):
-                assert l0 is not None and l1 is not None
-                t = b.rk.calc(q0, *b.via_state(slot0, l0.sigma, False), q1, *b.via_state(slot1, l1.sigma, True))
-                if t is not None:
-                    best = min(best, l0.duration + t.duration + l1.duration)
-            assert chosen == pytest.approx(best, abs=1e-12)
 
 
 @pytest.mark.parametrize("field", ["collision_rate_hz", "vertical_tol_m", "clearance_m"])

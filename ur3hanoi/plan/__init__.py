@@ -1,0 +1,92 @@
+"""Motion plan of a Hanoi solve: waypoints from the table, time-parameterized by Ruckig under the UR3's limits.
+
+Entry points: :func:`plan_solve` (solve the instance, then plan it) and :func:`plan_moves` (plan a given move
+sequence); both return a :class:`Plan`. Everything listed in ``__all__`` is importable from ``ur3hanoi.plan``.
+
+Module map (dependencies flow downward only):
+
+- :mod:`~ur3hanoi.plan.types`: the data types: :class:`Phase`, :class:`Trajectory`, :class:`KinematicLimits`,
+  :class:`PlanConfig`, :class:`Segment`, :class:`Plan`.
+- :mod:`~ur3hanoi.plan.ruckig`: the one Ruckig wrapper of the project (offline only, keeps Ruckig's ``Result``):
+  :class:`OfflineRuckig`, :class:`RuckigSolution`, :func:`to_rest`, :func:`to_pose`, :func:`control_samples`.
+- :mod:`~ur3hanoi.plan.vertical`: a slot's vertical line as a joint-space path (:class:`VerticalPath`), its
+  limits (:class:`~ur3hanoi.plan.vertical.PathLimits`) and braking speed.
+- :mod:`~ur3hanoi.plan.waypoints`: :func:`build_waypoints`: home, the IK table and every slot's vertical path.
+- :mod:`~ur3hanoi.plan.via`: via speeds at the above points: leg candidates and the (exit, entry) search.
+- :mod:`~ur3hanoi.plan.builder`: :class:`~ur3hanoi.plan.builder.SegmentBuilder` chains the Ruckig segments of
+  a move sequence (pass-through or stop-and-go); how the motion is built is described there.
+- :mod:`~ur3hanoi.plan.sampling`: :func:`sample`: the exact vectorised re-implementation of Ruckig's
+  ``Trajectory.at_time`` that samples the whole plan at ``rate_hz``.
+- :mod:`~ur3hanoi.plan.checks`: :func:`check_limits` and :func:`check_vertical` (the 2 mm vertical line).
+- :mod:`~ur3hanoi.plan.collision`: :class:`CollisionScene` and :func:`check_collisions` (clearances).
+- :mod:`~ur3hanoi.plan.export`: :func:`trajectory_csv` and the JSON summary behind :meth:`Plan.to_json_dict`
+  (what ``ur3hanoi plan`` prints).
+- :mod:`~ur3hanoi.plan.planner`: :func:`plan_moves` / :func:`plan_solve`: waypoints -> segments -> samples ->
+  checks -> :class:`Plan`.
+
+CONTRACT (shared with ur3hanoi.sim; keep these names and meanings):
+
+- :class:`Phase` labels every trajectory sample.
+- :class:`Trajectory` holds the samples at ``rate_hz``: ``t`` (N,) [s], ``q``/``qd``/``qdd``/``qddd`` (N, 6)
+  [rad, rad/s, rad/s^2, rad/s^3], ``suction`` (N,) bool (commanded suction), ``move_index`` (N,) int (0-based
+  index into ``Plan.moves``, -1 before the first move / on the way home), ``phase`` (N,) int (Phase values).
+- :class:`Plan`: ``station``, ``moves`` (tuple of hanoi.Move), ``trajectory``, ``stop_and_go_duration_s``,
+  ``config``.
+
+Limits: velocity from the UR3 datasheet (``JointLimits.ur3().v_max``: pi rad/s joints 1-3, 2pi rad/s joints 4-6);
+acceleration 4/8 rad/s^2 and jerk 20/40 rad/s^3 (joints 1-3 / 4-6) are ``JointLimits`` defaults (UR does not
+publish them). ``PlanConfig.speed`` scales all three; each can be overridden. Every sample is checked against
+them, every sample of a vertical phase against the vertical line (``PlanConfig.vertical_tol_m``, 2 mm), and the
+clearances by :func:`check_collisions`.
+"""
+
+from ur3hanoi.plan.checks import check_limits, check_vertical, tcp_positions_world
+from ur3hanoi.plan.collision import CollisionScene, check_collisions
+from ur3hanoi.plan.export import trajectory_csv
+from ur3hanoi.plan.planner import plan_moves, plan_solve
+from ur3hanoi.plan.ruckig import OfflineRuckig, RuckigSolution, control_samples, to_pose, to_rest
+from ur3hanoi.plan.sampling import sample
+from ur3hanoi.plan.types import (
+    DEFAULT_VIA_FRACTIONS,
+    DWELL_PHASES,
+    SUCTION_PHASES,
+    VERTICAL_PHASES,
+    KinematicLimits,
+    Phase,
+    Plan,
+    PlanConfig,
+    Segment,
+    Trajectory,
+)
+from ur3hanoi.plan.vertical import VerticalPath
+from ur3hanoi.plan.waypoints import Waypoints, build_waypoints
+
+__all__ = [
+    "DEFAULT_VIA_FRACTIONS",
+    "DWELL_PHASES",
+    "SUCTION_PHASES",
+    "VERTICAL_PHASES",
+    "CollisionScene",
+    "KinematicLimits",
+    "OfflineRuckig",
+    "Phase",
+    "Plan",
+    "PlanConfig",
+    "RuckigSolution",
+    "Segment",
+    "Trajectory",
+    "VerticalPath",
+    "Waypoints",
+    "build_waypoints",
+    "check_collisions",
+    "check_limits",
+    "check_vertical",
+    "control_samples",
+    "plan_moves",
+    "plan_solve",
+    "sample",
+    "tcp_positions_world",
+    "to_pose",
+    "to_rest",
+    "trajectory_csv",
+]

@@ -1,0 +1,262 @@
+"""Clearance checks of a sampled plan: the UR3's collision meshes, the suction cup and the carried block against
+the table and the resting blocks (Pinocchio geometry, coal distances), decimated with a proven margin.
+
+The pair rules (which pairs are checked in which phase, and which are excluded as contact by design) are the
+functions :func:`_resting_blocks`, :func:`_robot_pairs` and :func:`_carried_block_pairs`; see
+:class:`CollisionScene` for the geometry, the required distances and the decimation argument.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from functools import lru_cache
+
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+
+from ur3hanoi.arrays import FloatArray
+from ur3hanoi.grid import R_world_tcp_down, block_center_world, table_z
+from ur3hanoi.hanoi import Move, stacks_before_moves
+from ur3hanoi.plan.types import DWELL_PHASES, VERTICAL_PHASES, KinematicLimits, Phase, PlanConfig, Trajectory
+from ur3hanoi.robot import N_JOINTS, T_BASELINK_BASE, load_ur3
+from ur3hanoi.station import Station
+
+Slot = tuple[int, int]  # (tower, height), 0-based
+Pair = tuple[tuple[int, int], float]  # (geometry ids, required distance [m])
+MAX_REPORTED = 5  # violations reported per plan
+
+# Phases in which the cup touches the block of the move (picking it, or just having placed it).
+_CUP_ON_MOVED_BLOCK = (Phase.DESCEND_PICK, Phase.GRASP_DWELL, Phase.RELEASE_DWELL, Phase.RETREAT)
+
+
+class CollisionScene:
+    """Pinocchio GeometryModel of the UR3's URDF collision meshes plus coal boxes: the table, the resting blocks,
+    the carried block (attached to the suction point) and a small suction cup at the TCP.
+
+    Distances come from ``pin.computeDistance`` (coal); the robot's meshes are replaced by their convex hulls
+    (conservative, much faster). Required distances: robot geometry and carried block
+    above the table (> 0), robot geometry clear of resting blocks (> 0), carried block >= ``clearance_m`` from
+    every other block. Pairs excluded, and why:
+
+    - base_link vs table: the robot is mounted on the table.
+    - cup vs the block being picked (descend/grasp) or just placed (release/retreat): contact by design.
+    - carried block vs the block under it (stacked layout) during lift / descend-place, and vs the table during
+      lift / descend-place: the block rests on them at contact.
+    - cup vs table during the vertical and dwell phases: the cup is at contact there.
+
+    Decimation (proof sketch): every point of the robot and of the carried block moves at most
+    ``sum_i |qd_i| R_i`` [m/s], with ``R_i`` a bound on the distance from joint i's origin to any geometry
+    downstream of it (sum of the following joint offsets plus the geometry's offset and bounding radius). Over a
+    coarse interval [t_a, t_b] no point is farther than ``delta = sum_i max|qd_i| R_i (t_b - t_a) / 2`` from its
+    position at the nearer end (max over the interval's samples plus a_max times half a sample step), and a
+    distance between two bodies changes at most by the displacement of their points. A pair whose distance
+    exceeds ``required + delta`` at both ends is therefore fine at every sample in between; otherwise every
+    sample of the interval is checked.
+    """
+
+    CUP_RADIUS_M = 0.01
+    CUP_LENGTH_M = 0.02
+
+    def __init__(self, station: Station, n_blocks: int) -> None:
+        import coal
+
+        self.station = station
+        robot = load_ur3(station.tool, station.limits)
+        self.robot = robot
+        self.model = robot.model
+        self.data = self.model.createData()
+        gm = pin.buildGeomFromUrdfString(self.model, robot.urdf, pin.COLLISION)
+        for g in gm.geometryObjects:
+            # Convex hulls of the URDF meshes: ~30x faster GJK distances than the triangle BVHs, and a superset of
+            # each mesh, so a distance can only be under-estimated (the check stays conservative).
+            if isinstance(g.geometry, coal.BVHModelBase):
+                g.geometry.buildConvexRepresentation(False)
+                g.geometry = g.geometry.convex
+        self.robot_geoms = list(range(len(gm.geometryObjects)))
+        names = [g.name for g in gm.geometryObjects]
+        self.base_geom = names.index("base_link_0") if "base_link_0" in names else -1
+        T_baselink_world = T_BASELINK_BASE * station.T_world_base.inverse()
+        self.T_baselink_world = T_baselink_world
+        fid = robot.frame_ids["tcp"]
+        frame = self.model.frames[fid]
+        joint6 = frame.parentJoint
+        T_j6_tcp = frame.placement
+        # Suction cup: a short cylinder above the suction point (tcp z points into the block).
+        cup = pin.GeometryObject("cup", joint6, fid, T_j6_tcp * pin.SE3(np.eye(3), np.array(
+            [0.0, 0.0, -0.5 * self.CUP_LENGTH_M])), coal.Cylinder(self.CUP_RADIUS_M, self.CUP_LENGTH_M))
+        self.cup = gm.addGeometryObject(cup)
+        s = station.block_size
+        # Block centre seen from the TCP: contact_depth - s/2 above it, i.e. along tcp -z.
+        T_tcp_block = pin.SE3(np.eye(3), np.array([0.0, 0.0, -(station.contact_depth - 0.5 * s)]))
+        self.carried = gm.addGeometryObject(pin.GeometryObject("carried_block", joint6, fid, T_j6_tcp * T_tcp_block,
+                                                               coal.Box(s, s, s)))
+        tz = table_z(station)
+        table = pin.GeometryObject("table", 0, 0, T_baselink_world * pin.SE3(np.eye(3), np.array(
+            [0.0, 0.0, tz - 0.05])), coal.Box(4.0, 4.0, 0.1))
+        self.table = gm.addGeometryObject(table)
+        self.blocks = []
+        for b in range(n_blocks):
+            self.blocks.append(gm.addGeometryObject(pin.GeometryObject(f"block_{b}", 0, 0, pin.SE3.Identity(),
+                                                                       coal.Box(s, s, s))))
+        self.gm = gm
+        self.pairs: dict[tuple[int, int], int] = {}
+        movers = [*self.robot_geoms, self.cup, self.carried]
+        for a in movers:
+            for b in [self.table, *self.blocks]:
+                self.pairs[(a, b)] = len(self.pairs)
+                gm.addCollisionPair(pin.CollisionPair(a, b))
+        self.gd = pin.GeometryData(gm)
+        self.R = self._reach_bounds()
+        self._R_block = R_world_tcp_down(station.tool_yaw)
+
+    def _reach_bounds(self) -> FloatArray:
+        """R_i [m]: bound on the distance from joint i's origin to any geometry attached at or after joint i."""
+        m = self.model
+        offs = [float(np.linalg.norm(m.jointPlacements[j].translation)) for j in range(m.njoints)]
+        R = np.zeros(N_JOINTS)
+        for i in range(1, N_JOINTS + 1):
+            chain = sum(offs[i + 1:])
+            extent = 0.0
+            for g in self.gm.geometryObjects:
+                if g.parentJoint >= i:
+                    g.geometry.computeLocalAABB()
+                    ext = (float(np.linalg.norm(g.placement.translation))
+                           + float(np.linalg.norm(g.geometry.aabb_center)) + float(g.geometry.aabb_radius))
+                    extent = max(extent, ext)
+            R[i - 1] = chain + extent
+        return R
+
+    def place_blocks(self, slots: dict[int, tuple[int, int]]) -> None:
+        """Put each resting block (block -> (tower, height)) at its slot; blocks not listed are parked far away."""
+        for b, gid in enumerate(self.blocks):
+            p = block_center_world(self.station, *slots[b]) if b in slots else np.array([100.0 + 10 * b, 100.0, 100.0])
+            self.gm.geometryObjects[gid].placement = self.T_baselink_world * pin.SE3(self._R_block, p)
+
+    def distances(self, q: FloatArray, pairs: Sequence[tuple[int, int]]) -> FloatArray:
+        pin.updateGeometryPlacements(self.model, self.data, self.gm, self.gd, q)
+        return np.array([pin.computeDistance(self.gm, self.gd, self.pairs[p]).min_distance for p in pairs])
+
+    def name(self, gid: int) -> str:
+        return self.gm.geometryObjects[gid].name
+
+
+@lru_cache(maxsize=8)
+def _collision_scene(station: Station, n_blocks: int) -> CollisionScene:
+    """The scene of a station and block count, built once: reading and hulling the URDF meshes (~0.2 s) is most of
+    a clearance check otherwise. Shared like ``load_ur3``'s models, so not thread-safe either."""
+    return CollisionScene(station, n_blocks)
+
+
+
+def _resting_blocks(stacks: Sequence[Sequence[Sequence[int]]], moves: Sequence[Move], mi: int,
+                    ph: Phase) -> dict[int, Slot]:
+    """Block -> slot of every block at rest during phase ``ph`` of move ``mi`` (-1: before the first move, or on
+    the way home): the carried block is not at rest; a just-placed block rests on its destination."""
+    state = stacks[mi] if mi >= 0 else (stacks[-1] if ph == Phase.HOME else stacks[0])
+    slots = {b: (t, h) for t, st in enumerate(state) for h, b in enumerate(st)}
+    if mi < 0:
+        return slots
+    m = moves[mi]
+    if ph in (Phase.RELEASE_DWELL, Phase.RETREAT):
+        slots.pop(m.block, None)
+        slots[m.block] = (m.to_tower, m.to_height)
+    if ph.carrying:
+        slots.pop(m.block, None)
+    return slots
+
+
+def _robot_pairs(scene: CollisionScene, ph: Phase, m: Move | None, slots: dict[int, Slot]) -> list[Pair]:
+    """Robot geometry and cup vs the table and every resting block (> 0), except: the base (mounted on the table),
+    the cup vs the table while at contact (vertical and dwell phases), the cup vs the block it picks or placed."""
+    pairs: list[Pair] = []
+    for g in [*scene.robot_geoms, scene.cup]:
+        if g == scene.base_geom:
+            continue
+        if not (g == scene.cup and ph in (*VERTICAL_PHASES, *DWELL_PHASES)):
+            pairs.append(((g, scene.table), 0.0))
+        for b in slots:
+            if g == scene.cup and m is not None and b == m.block and ph in _CUP_ON_MOVED_BLOCK:
+                continue
+            pairs.append(((g, scene.blocks[b]), 0.0))
+    return pairs
+
+
+def _carried_block_pairs(scene: CollisionScene, ph: Phase, m: Move, slots: dict[int, Slot],
+                         clearance_m: float) -> list[Pair]:
+    """The carried block vs the table (> 0, while carrying across) and every resting block (>= ``clearance_m``),
+    except the block it rests on at contact (stacked layout: the one under its source while lifting, under its
+    destination while descending to place)."""
+    pairs: list[Pair] = []
+    if ph == Phase.CARRY:
+        pairs.append(((scene.carried, scene.table), 0.0))
+    under = None
+    if scene.station.layout == "stacked":
+        if ph == Phase.LIFT and m.from_height > 0:
+            under = (m.from_tower, m.from_height - 1)
+        if ph == Phase.DESCEND_PLACE and m.to_height > 0:
+            under = (m.to_tower, m.to_height - 1)
+    for b, slot in slots.items():
+        if slot != under:
+            pairs.append(((scene.carried, scene.blocks[b]), clearance_m))
+    return pairs
+
+
+def _decimated_distances(scene: CollisionScene, tr: Trajectory, run: npt.NDArray[np.intp],
+                         keys: list[tuple[int, int]], required: FloatArray, stride: int,
+                         speed_bound: FloatArray) -> dict[int, FloatArray]:
+    """Distances of ``keys`` at every ``stride``-th sample of ``run`` (and its last), and at every sample of a
+    coarse interval whose margin does not prove the pairs clear in between (see :class:`CollisionScene`)."""
+    coarse = list(run[::stride])
+    if coarse[-1] != run[-1]:
+        coarse.append(run[-1])
+    d_coarse = {k: scene.distances(tr.q[k], keys) for k in coarse}
+    checked: dict[int, FloatArray] = dict(d_coarse)
+    for a, b in itertools.pairwise(coarse):
+        vmax = np.max(speed_bound[a:b + 1], axis=0)
+        delta = float(np.sum(vmax * scene.R)) * (tr.t[b] - tr.t[a]) / 2
+        if np.any(np.minimum(d_coarse[a], d_coarse[b]) - required < delta):
+            for k in range(a + 1, b):
+                checked[k] = scene.distances(tr.q[k], keys)
+    return checked
+
+
+def check_collisions(tr: Trajectory, moves: Sequence[Move], station: Station, n_blocks: int, start: int,
+                     config: PlanConfig, limits: KinematicLimits) -> list[str]:
+    """Clearance checks of :class:`CollisionScene` on the sampled trajectory (at most ``MAX_REPORTED``)."""
+    scene = _collision_scene(station, n_blocks)
+    # Fresh GeometryData: Pinocchio warm-starts GJK from each pair's previous query (enable_cached_gjk_guess), so
+    # reusing it would let the distances depend, in the last bits, on the plans checked before. Block placements
+    # need no reset: every run below places all blocks before its first query.
+    scene.gd = pin.GeometryData(scene.gm)
+    stacks = stacks_before_moves(moves, n_blocks, start, station.n_towers)
+    out: list[str] = []
+    dt = 1.0 / tr.rate_hz
+    stride = max(1, round(tr.rate_hz / config.collision_rate_hz))
+    speed_bound = np.abs(tr.qd) + limits.a_max * dt / 2  # bound between samples
+    # Runs of constant (move, phase): the resting blocks and the checked pairs are fixed within each.
+    change = np.flatnonzero((np.diff(tr.phase) != 0) | (np.diff(tr.move_index) != 0)) + 1
+    for run in np.split(np.arange(len(tr.t)), change):
+        mi, ph = int(tr.move_index[run[0]]), Phase(int(tr.phase[run[0]]))
+        m = moves[mi] if mi >= 0 else None
+        slots = _resting_blocks(stacks, moves, mi, ph)
+        scene.place_blocks(slots)
+        pairs = _robot_pairs(scene, ph, m, slots)
+        if m is not None and ph.carrying:
+            pairs += _carried_block_pairs(scene, ph, m, slots, config.clearance_m)
+        if not pairs:
+            continue
+        keys = [p for p, _ in pairs]
+        req = np.array([r for _, r in pairs])
+        checked = _decimated_distances(scene, tr, run, keys, req, stride, speed_bound)
+        for k in sorted(checked):
+            bad = np.flatnonzero(checked[k] < req + (req == 0) * 1e-9)
+            for j in bad:
+                g1, g2 = keys[j]
+                out.append(f"{scene.name(g1)} is {checked[k][j] * 1e3:.2f} mm from {scene.name(g2)} (required "
+                           f"{req[j] * 1e3:.1f} mm) at t = {tr.t[k]:.3f} s ({ph.name}, move {mi + 1})")
+                break
+            if len(out) >= MAX_REPORTED:
+                return out
+    return out

@@ -1,0 +1,73 @@
+"""The planning pipeline: waypoints -> chained Ruckig segments -> samples -> safety checks -> :class:`Plan`."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+
+from ur3hanoi.errors import PlanError
+from ur3hanoi.hanoi import Move, check_sequence, solve_hanoi
+from ur3hanoi.plan.builder import SegmentBuilder
+from ur3hanoi.plan.checks import check_limits, check_vertical
+from ur3hanoi.plan.collision import check_collisions
+from ur3hanoi.plan.sampling import sample
+from ur3hanoi.plan.types import Plan, PlanConfig
+from ur3hanoi.plan.waypoints import build_waypoints
+from ur3hanoi.station import Station
+
+
+def plan_moves(station: Station, moves: Sequence[Move], config: PlanConfig | None = None, *, start: int = 0,
+               end: int = 1, n_blocks: int | None = None) -> Plan:
+    """Time-parameterize a given (legal) move sequence on ``station``; see :func:`plan_solve`."""
+    config = config or PlanConfig()
+    config.validate()
+    n_blocks = n_blocks if n_blocks is not None else (max(m.block for m in moves) + 1 if moves else 0)
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    wp = build_waypoints(station)
+    timings["waypoints"] = time.perf_counter() - t0
+    builder = SegmentBuilder(station, wp, config)
+    limits = builder.limits
+    t0 = time.perf_counter()
+    segments = builder.build(moves)
+    timings["build"] = time.perf_counter() - t0
+    timings["ruckig"] = builder.ruckig_seconds
+    # Stop-and-go reference: the same waypoints and limits, zero velocity at every waypoint.
+    t0 = time.perf_counter()
+    stop_go = SegmentBuilder(station, wp, config, pass_through=False).build(moves)[-1].t_end
+    timings["stop_and_go"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    tr = sample(segments, config.rate_hz)
+    timings["sampling"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    violations = check_limits(tr, segments, limits, station.limits.q_min, station.limits.q_max)
+    vert, _ = check_vertical(tr, moves, station, config.vertical_tol_m)
+    violations += vert
+    timings["checks"] = time.perf_counter() - t0
+    if config.check_collisions and moves:
+        t0 = time.perf_counter()
+        violations += check_collisions(tr, moves, station, n_blocks, start, config, limits)
+        timings["collision"] = time.perf_counter() - t0
+    duration = segments[-1].t_end
+    dwell_total = 2 * len(moves) * config.dwell_s
+    plan = Plan(station=station, moves=tuple(moves), trajectory=tr, stop_and_go_duration_s=stop_go, config=config,
+                segments=tuple(segments), limits=limits, violations=tuple(violations), duration_s=duration,
+                dwell_total_s=dwell_total, stop_and_go_motion_s=stop_go - dwell_total, start=start, end=end,
+                n_blocks=n_blocks, timings_s=timings)
+    if violations and config.raise_on_violation:
+        more = f" (+{len(violations) - 1} more)" if len(violations) > 1 else ""
+        raise PlanError(f"plan on {station.name} violates a safety check: {violations[0]}{more}")
+    return plan
+
+
+def plan_solve(station: Station, start: int, end: int, n_blocks: int, config: PlanConfig | None = None) -> Plan:
+    """Solve the Hanoi instance (0-based towers) and time-parameterize the whole motion with Ruckig.
+
+    Raises:
+        PuzzleError: invalid instance (start == end, tower outside the grid, too many blocks).
+        PlanError: Ruckig failure or a safety check violation (limits, vertical approach, clearance).
+        IKError: a waypoint is unreachable on the home branch.
+    """
+    moves = solve_hanoi(n_blocks, start, end, station.n_towers, station.n_heights)
+    check_sequence(moves, n_blocks, start, end, station.n_towers, station.n_heights)
+    return plan_moves(station, moves, config, start=start, end=end, n_blocks=n_blocks)

@@ -1,0 +1,230 @@
+"""The data types of a motion plan: phases, the sampled trajectory, limits, settings, segments and the plan.
+
+All are frozen dataclasses (or an IntEnum); the modules of :mod:`ur3hanoi.plan` create and read them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import IntEnum
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+from ruckig import Trajectory as RuckigTrajectory
+
+from ur3hanoi.arrays import FloatArray
+from ur3hanoi.errors import PlanError
+from ur3hanoi.hanoi import Move
+from ur3hanoi.robot import N_JOINTS
+from ur3hanoi.station import Station
+
+if TYPE_CHECKING:
+    from ur3hanoi.plan.vertical import VerticalPath
+
+DEFAULT_VIA_FRACTIONS: tuple[float, ...] = (1.0, 0.8, 0.6, 0.4, 0.2, 0.0)
+
+
+class Phase(IntEnum):
+    """What the robot is doing at a trajectory sample."""
+
+    TRANSIT = 0  # home/previous place -> above(src), empty cup
+    DESCEND_PICK = 1  # above(src) -> on(src), empty cup
+    GRASP_DWELL = 2  # at on(src), suction on, waiting for the vacuum
+    LIFT = 3  # on(src) -> above(src), carrying
+    CARRY = 4  # above(src) -> above(dst), carrying
+    DESCEND_PLACE = 5  # above(dst) -> on(dst), carrying
+    RELEASE_DWELL = 6  # at on(dst), suction off, waiting for the release
+    RETREAT = 7  # on(dst) -> above(dst), empty cup
+    HOME = 8  # last above -> home, suction off
+
+    @property
+    def carrying(self) -> bool:
+        """True when a block must be held during this phase (suction feedback is checked)."""
+        return self in (Phase.LIFT, Phase.CARRY, Phase.DESCEND_PLACE)
+
+
+VERTICAL_PHASES = (Phase.DESCEND_PICK, Phase.LIFT, Phase.DESCEND_PLACE, Phase.RETREAT)
+DWELL_PHASES = (Phase.GRASP_DWELL, Phase.RELEASE_DWELL)
+# Commanded suction: on from the grasp dwell until the block is on its destination.
+SUCTION_PHASES = (Phase.GRASP_DWELL, Phase.LIFT, Phase.CARRY, Phase.DESCEND_PLACE)
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Sampled joint trajectory at ``rate_hz``.
+
+    Samples are uniform, ``t[i] = i / rate_hz``; the last sample is the first one at or after the end of the
+    motion, so it holds the final (home) state exactly.
+
+    Attributes:
+        t: (N,) sample times [s].
+        q, qd, qdd, qddd: (N, 6) joint position, velocity, acceleration, jerk [rad, rad/s, rad/s^2, rad/s^3].
+        suction: (N,) commanded suction.
+        move_index: (N,) 0-based index into ``Plan.moves``; -1 before the first move and on the way home.
+        phase: (N,) :class:`Phase` values.
+    """
+
+    rate_hz: float
+    t: FloatArray
+    q: FloatArray
+    qd: FloatArray
+    qdd: FloatArray
+    qddd: FloatArray
+    suction: npt.NDArray[np.bool_]
+    move_index: npt.NDArray[np.int_]
+    phase: npt.NDArray[np.int_]
+
+    @property
+    def duration_s(self) -> float:
+        return float(self.t[-1] - self.t[0])
+
+
+@dataclass(frozen=True)
+class KinematicLimits:
+    """Per-joint limits used for planning [rad/s, rad/s^2, rad/s^3], already scaled by ``PlanConfig.speed``."""
+
+    v_max: FloatArray
+    a_max: FloatArray
+    j_max: FloatArray
+
+
+@dataclass(frozen=True)
+class PlanConfig:
+    """Planner settings. ``speed`` scales velocity, acceleration and jerk limits (0 < speed <= 1).
+
+    Attributes:
+        speed: scale of v_max, a_max and j_max (0 < speed <= 1).
+        rate_hz: sample rate [Hz]; 125 (CB3) or 500 (e-Series), any positive rate is accepted.
+        dwell_s: time at rest at each contact pose for the suction to build up / release [s].
+        v_max, a_max, j_max: per-joint overrides [rad/s, rad/s^2, rad/s^3] (None: the station's JointLimits).
+        pass_through: False plans stop-and-go (zero velocity at every waypoint).
+        via_fractions: candidate fractions of the largest feasible vertical speed at the "above" via points.
+        vertical_tol_m: allowed distance [m] of the suction point from the vertical line in vertical phases.
+        clearance_m: required clearance [m] of the carried block from every other block.
+        check_collisions: run the Pinocchio/coal clearance checks (slower; limits are always checked).
+        collision_rate_hz: coarse rate [Hz] of the clearance check; refined to every sample where the margin is
+            not provably enough (see :class:`ur3hanoi.plan.collision.CollisionScene`).
+        raise_on_violation: raise PlanError on the first violation list (False: return it in Plan.violations).
+    """
+
+    speed: float = 1.0
+    rate_hz: float = 125.0
+    dwell_s: float = 0.3
+    v_max: tuple[float, ...] | None = None
+    a_max: tuple[float, ...] | None = None
+    j_max: tuple[float, ...] | None = None
+    pass_through: bool = True
+    via_fractions: tuple[float, ...] = DEFAULT_VIA_FRACTIONS
+    vertical_tol_m: float = 0.002
+    clearance_m: float = 0.005
+    check_collisions: bool = True
+    collision_rate_hz: float = 25.0
+    raise_on_violation: bool = True
+
+    def validate(self) -> None:
+        """Raise PlanError naming the first invalid setting."""
+        if not (math.isfinite(self.speed) and 0.0 < self.speed <= 1.0):
+            raise PlanError(f"speed = {self.speed!r} is invalid: expected 0 < speed <= 1")
+        if not (math.isfinite(self.rate_hz) and self.rate_hz > 0.0):
+            raise PlanError(f"rate = {self.rate_hz!r} Hz is invalid: expected a positive rate (125 or 500)")
+        if not (math.isfinite(self.dwell_s) and self.dwell_s >= 0.0):
+            raise PlanError(f"dwell = {self.dwell_s!r} s is invalid: expected >= 0")
+        for name in ("v_max", "a_max", "j_max"):
+            v = getattr(self, name)
+            if v is not None and (len(v) != N_JOINTS or not all(math.isfinite(x) and x > 0 for x in v)):
+                raise PlanError(f"{name} = {v!r} is invalid: expected {N_JOINTS} positive numbers")
+        if not self.via_fractions or not all(0.0 <= f <= 1.0 for f in self.via_fractions):
+            raise PlanError(f"via_fractions = {self.via_fractions!r} is invalid: expected values in [0, 1]")
+        for name in ("collision_rate_hz", "vertical_tol_m", "clearance_m"):
+            x = getattr(self, name)
+            if not (math.isfinite(x) and x > 0.0):  # NaN compares False everywhere: test finiteness explicitly
+                raise PlanError(f"{name} = {x!r} is invalid: expected a finite number > 0")
+
+    def limits(self, station: Station) -> KinematicLimits:
+        """The scaled planning limits for ``station``."""
+        lim = station.limits
+        v = np.asarray(self.v_max if self.v_max is not None else lim.v_max, dtype=float)
+        a = np.asarray(self.a_max if self.a_max is not None else lim.a_max, dtype=float)
+        j = np.asarray(self.j_max if self.j_max is not None else lim.j_max, dtype=float)
+        return KinematicLimits(v_max=v * self.speed, a_max=a * self.speed, j_max=j * self.speed)
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One Ruckig segment (or a dwell) of the plan.
+
+    ``trajectory`` is the Ruckig trajectory of the segment (time 0 = ``t_start``), None for a dwell at rest at
+    ``q_start``. For a vertical leg ``path`` is set and ``trajectory`` is the 1-DoF Ruckig trajectory of the path
+    coordinate s [m] (see :class:`ur3hanoi.plan.vertical.VerticalPath`); otherwise it is 6-DoF in joint space.
+    ``target`` names the waypoint reached at the segment's end (1-based tower/height).
+    """
+
+    phase: Phase
+    move_index: int
+    t_start: float  # [s]
+    duration: float  # [s]
+    q_start: FloatArray  # [rad]
+    q_end: FloatArray  # [rad]
+    v_start: FloatArray  # [rad/s]
+    v_end: FloatArray  # [rad/s]
+    target: str
+    trajectory: RuckigTrajectory | None = None
+    path: VerticalPath | None = None
+
+    @property
+    def t_end(self) -> float:
+        return self.t_start + self.duration
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A planned Hanoi solve.
+
+    Attributes:
+        station, moves, config: the station, the move sequence and the settings planned with.
+        trajectory: the sampled motion.
+        stop_and_go_duration_s: cycle time [s] of the same waypoints with zero velocity at each.
+        segments: the chained Ruckig segments and dwells.
+        limits: the planning limits actually used.
+        violations: safety check failures (empty for a valid plan; non-empty only if not raise_on_violation).
+        duration_s: exact cycle time [s] (the sampled trajectory ends on the first sample at or after it).
+        dwell_total_s: time at rest in the grasp/release dwells [s].
+        stop_and_go_motion_s: stop-and-go cycle minus the same dwells [s].
+        start, end, n_blocks: the instance (0-based towers).
+        timings_s: wall-clock planning times [s]: "ruckig" (calculate calls), "sampling", "checks", "collision".
+    """
+
+    station: Station
+    moves: tuple[Move, ...]
+    trajectory: Trajectory
+    stop_and_go_duration_s: float
+    config: PlanConfig
+    segments: tuple[Segment, ...] = ()
+    limits: KinematicLimits | None = None
+    violations: tuple[str, ...] = ()
+    duration_s: float = 0.0
+    dwell_total_s: float = 0.0
+    stop_and_go_motion_s: float = 0.0
+    start: int = 0
+    end: int = 0
+    n_blocks: int = 0
+    timings_s: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def motion_s(self) -> float:
+        """Cycle time minus the dwells [s]."""
+        return self.duration_s - self.dwell_total_s
+
+    @property
+    def motion_saving(self) -> float:
+        """Relative motion-time saving over stop-and-go (0.15 = 15 % faster)."""
+        return 1.0 - self.motion_s / self.stop_and_go_motion_s if self.stop_and_go_motion_s > 0 else 0.0
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (see :func:`ur3hanoi.plan.export.plan_json_dict`)."""
+        # Imported here: export reads plans, so a module-level import would be circular.
+        from ur3hanoi.plan.export import plan_json_dict
+
+        return plan_json_dict(self)

@@ -1,0 +1,165 @@
+"""Vertical legs: the straight-down line of a grid slot as a joint-space path ``q(s)``, and its speed limits.
+
+A straight joint-space line between a slot's above and on poses bends the suction point up to ~9 mm off the
+vertical on the lab stations. A vertical leg therefore follows :class:`VerticalPath`: closed-form IK points on the
+vertical line (on home's branch) every few millimetres, interpolated by a cubic Hermite spline of (q, dq/ds). A
+leg is a 1-DoF Ruckig trajectory of the path coordinate ``s`` [m] under :class:`PathLimits`, which keep every
+joint within its own limits; :func:`braking_speed` bounds the via speed a leg can stop from before the contact.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import pinocchio as pin
+
+from ur3hanoi.arrays import FloatArray
+from ur3hanoi.errors import PlanError
+from ur3hanoi.grid import ABOVE, ON, T_base_tcp
+from ur3hanoi.ik import analytic_ik, branch_of, nearest_equivalent
+from ur3hanoi.plan.types import KinematicLimits
+from ur3hanoi.robot import N_JOINTS, Ur3Model
+from ur3hanoi.station import Station
+
+FD_STEP_M = 1e-3  # [m] finite-difference step of the higher path derivatives
+
+
+@dataclass(frozen=True)
+class VerticalPath:
+    """The vertical line of one grid slot as a joint-space path ``q(s)``, ``s`` [m] = distance below "above".
+
+    Nodes every <= ``node_step_m`` by closed-form IK on the home branch (the end nodes are the table's entries);
+    ``q(s)`` between nodes is the cubic Hermite interpolant of (q, dq/ds), accurate to ~1e-10 rad.
+
+    Attributes:
+        s: (M,) node abscissae [m], 0 = above, length_m = on.
+        q: (M, 6) joint angles [rad].
+        dq: (M, 6) dq/ds [rad/m] (exact: J^-1 of a straight-down unit twist).
+        ddq, dddq: (M, 6) d2q/ds2 [rad/m^2], d3q/ds3 [rad/m^3] by finite differences of dq/ds.
+        length_m: approach length [m].
+    """
+
+    s: FloatArray
+    q: FloatArray
+    dq: FloatArray
+    ddq: FloatArray
+    dddq: FloatArray
+    length_m: float
+
+    @cached_property
+    def derivative_bounds(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Per-joint ``max |d^k q / ds^k|`` over the nodes for k = 1, 2, 3 (computed once per path: the waypoints,
+        and so their paths, are cached per station while every plan derives its path limits from these)."""
+        return (np.max(np.abs(self.dq), axis=0), np.max(np.abs(self.ddq), axis=0),
+                np.max(np.abs(self.dddq), axis=0))
+
+    def evaluate(self, s: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """(q, dq/ds, d2q/ds2, d3q/ds3) at ``s`` [m] (clamped to [0, length_m]): a cubic Hermite spline through
+        the IK nodes for q and dq/ds, linear for the higher derivatives."""
+        q, dq, ddq, dddq = self.evaluate_many(np.array([s], dtype=float))
+        return q[0], dq[0], ddq[0], dddq[0]
+
+    def evaluate_many(self, s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """:meth:`evaluate` at every ``s`` (N,) [m] at once: four (N, 6) arrays, with the same arithmetic."""
+        s = np.minimum(np.maximum(s, 0.0), self.length_m)
+        k = np.minimum(np.searchsorted(self.s, s, side="right") - 1, len(self.s) - 2)
+        h = (self.s[k + 1] - self.s[k])[:, None]
+        u = (s[:, None] - self.s[k][:, None]) / h
+        q0, q1, m0, m1 = self.q[k], self.q[k + 1], self.dq[k] * h, self.dq[k + 1] * h
+        u2, u3 = u * u, u * u * u
+        q = (2 * u3 - 3 * u2 + 1) * q0 + (u3 - 2 * u2 + u) * m0 + (-2 * u3 + 3 * u2) * q1 + (u3 - u2) * m1
+        dq = ((6 * u2 - 6 * u) * q0 + (3 * u2 - 4 * u + 1) * m0 + (-6 * u2 + 6 * u) * q1 + (3 * u2 - 2 * u) * m1) / h
+        ddq = (1 - u) * self.ddq[k] + u * self.ddq[k + 1]
+        dddq = (1 - u) * self.dddq[k] + u * self.dddq[k + 1]
+        return q, dq, ddq, dddq
+
+
+def tangent_down(robot: Ur3Model, R_world_base: FloatArray, q: FloatArray) -> FloatArray:
+    """Joint velocity [rad/s] moving the TCP at 1 m/s along world -z without rotating (J^-1 of the twist)."""
+    J = robot.frame_jacobian_local(q, "tcp")
+    R_world_tcp = R_world_base @ robot.fk(q, "tcp").rotation
+    twist = np.concatenate([R_world_tcp.T @ np.array([0.0, 0.0, -1.0]), np.zeros(3)])
+    return np.linalg.solve(J, twist)
+
+
+def line_ik(robot: Ur3Model, station: Station, tower: int, height: int) -> Callable[[float, FloatArray], FloatArray]:
+    """``ik(s, q_ref)``: closed-form IK [rad] of the suction point ``s`` [m] below the above pose of (tower, height),
+    on home's branch, nearest ``q_ref``."""
+    T_above = T_base_tcp(station, tower, height, ABOVE)
+    R_base_world = station.T_world_base.rotation.T
+    branch = branch_of(station.q_home_array)
+
+    def ik(s: float, q_ref: FloatArray) -> FloatArray:
+        T = pin.SE3(T_above.rotation, T_above.translation - R_base_world @ np.array([0.0, 0.0, s]))
+        sols = analytic_ik(T * robot.T_tcp_tool0, only=branch)
+        q = nearest_equivalent(sols[branch], q_ref, station.limits) if branch in sols else None
+        if q is None:
+            raise PlanError(f"tower {tower + 1} height {height + 1}: the vertical line {s * 1e3:.1f} mm below the "
+                            "above pose has no IK solution on home's branch within the joint limits")
+        return q
+
+    return ik
+
+
+def vertical_path(robot: Ur3Model, station: Station, table_q: FloatArray, tower: int, height: int,
+                  s_nodes: FloatArray) -> VerticalPath:
+    """The :class:`VerticalPath` of slot (tower, height) with nodes at ``s_nodes`` [m] (0 .. approach length).
+
+    ``table_q`` is the table ``q[tower, height, k]`` [rad]; its above/on entries become the end nodes exactly
+    (they agree with closed-form IK to ~1e-11 rad).
+    """
+    R_world_base = station.T_world_base.rotation
+    ik = line_ik(robot, station, tower, height)
+    n = len(s_nodes)
+    q_nodes = np.empty((n, N_JOINTS))
+    q_ref = table_q[tower, height, ABOVE]
+    for k, s in enumerate(s_nodes):
+        q_nodes[k] = q_ref = ik(float(s), q_ref)
+    q_nodes[0], q_nodes[-1] = table_q[tower, height, ABOVE], table_q[tower, height, ON]
+    dq = np.array([tangent_down(robot, R_world_base, q) for q in q_nodes])
+    ddq = np.empty_like(dq)
+    dddq = np.empty_like(dq)
+    for k, (s, q) in enumerate(zip(s_nodes, q_nodes, strict=True)):
+        dm = tangent_down(robot, R_world_base, ik(float(s) - FD_STEP_M, q))
+        dp = tangent_down(robot, R_world_base, ik(float(s) + FD_STEP_M, q))
+        ddq[k] = (dp - dm) / (2 * FD_STEP_M)
+        dddq[k] = (dp - 2 * dq[k] + dm) / (FD_STEP_M * FD_STEP_M)
+    return VerticalPath(s=s_nodes, q=q_nodes, dq=dq, ddq=ddq, dddq=dddq, length_m=station.approach)
+
+
+def braking_speed(dist: float, a: float, j: float) -> float:
+    """Largest speed a jerk-limited (a, j) profile starting at zero acceleration stops from within ``dist``."""
+    # Stopping distance d(v): v*sqrt(v/j) if the profile never reaches a (v <= a^2/j), else v^2/(2a) + v*a/(2j).
+    v_knee = a * a / j
+    if v_knee * math.sqrt(v_knee / j) >= dist:
+        return (dist * dist * j) ** (1.0 / 3.0)
+    b = a / (2 * j)
+    return (-b + math.sqrt(b * b + 2 * dist / a)) * a
+
+
+@dataclass(frozen=True)
+class PathLimits:
+    """Limits of the path coordinate s of a vertical leg [m/s, m/s^2, m/s^3].
+
+    They keep every joint within its limits through the chain rule ``qd = q1 sd``, ``qdd = q2 sd^2 + q1 sdd``,
+    ``qddd = q3 sd^3 + 3 q2 sd sdd + q1 sddd`` (``qk`` = k-th derivative of q(s)). Budget split, per joint, with
+    ``Dk = 1.05 max |qk|`` over the path: ``D1 v <= v_max``; ``D2 v^2 <= 0.4 a_max`` and ``D1 a`` takes the rest;
+    ``D3 v^3 <= 0.3 j_max``, ``3 D2 v a <= 0.4 j_max`` and ``D1 j`` takes the rest.
+    """
+
+    v: float
+    a: float
+    j: float
+
+    @classmethod
+    def for_path(cls, path: VerticalPath, lim: KinematicLimits) -> PathLimits:
+        D1, D2, D3 = (1.05 * x + 1e-12 for x in path.derivative_bounds)
+        v = float(np.min(np.minimum.reduce([lim.v_max / D1, np.sqrt(0.4 * lim.a_max / D2),
+                                            np.cbrt(0.3 * lim.j_max / D3)])))
+        a = float(np.min(np.minimum((lim.a_max - D2 * v * v) / D1, 0.4 * lim.j_max / (3 * D2 * v))))
+        j = float(np.min((lim.j_max - D3 * v**3 - 3 * D2 * v * a) / D1))
+        return cls(v, a, j)
