@@ -28,7 +28,7 @@ def planned(name: str, start: int, end: int) -> Plan:
 
 
 def quintic_segment(q0: FloatArray, q1: FloatArray, station: Station, speed: float, rate: float
-                     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Rest-to-rest quintic (smoothstep) from q0 to q1 within the joint limits, sampled at ``rate`` [Hz]."""
     lim = station.limits
     dq = q1 - q0

@@ -26,8 +26,11 @@ HALT_VELOCITY_TRACKING = 0.2  # [rad/s]
 HALT_ACCELERATION_FACTOR = 1.25  # measured cycle-mean acceleration / a_max
 
 
+Solved = dict[tuple[str, int, int], SimResult]
+
+
 @pytest.fixture(scope="module")
-def solved() -> dict[tuple[str, int, int], SimResult]:
+def solved() -> Solved:
     return {(name, s, e): run_plan(planned(name, s, e)) for name in STATIONS for s, e in PAIRS}
 
 
@@ -44,7 +47,7 @@ def run_faulty(plan_key: tuple[str, int, int], faults: Faults, **kwargs: object)
 
 @pytest.mark.parametrize("name", STATIONS)
 @pytest.mark.parametrize(("start", "end"), PAIRS)
-def test_every_start_end_pair_solves(solved, name: str, start: int, end: int) -> None:
+def test_every_start_end_pair_solves(solved: Solved, name: str, start: int, end: int) -> None:
     r = solved[(name, start, end)]
     assert r.status == "solved" and r.exit_code == 0 and r.error is None, r.error
     assert r.moves_completed == r.moves_total == 7
@@ -57,12 +60,12 @@ def test_every_start_end_pair_solves(solved, name: str, start: int, end: int) ->
 
 
 @pytest.mark.parametrize("name", STATIONS)
-def test_tracking_error_below_half_a_degree(solved, name: str) -> None:
+def test_tracking_error_below_half_a_degree(solved: Solved, name: str) -> None:
     worst = max(r.max_tracking_error_rad for (n, _, _), r in solved.items() if n == name)
     assert worst < MAX_TRACKING_RAD, f"{math.degrees(worst):.3f} deg"
 
 
-def test_joint_trace_streams_the_plan_then_holds_its_end(solved) -> None:
+def test_joint_trace_streams_the_plan_then_holds_its_end(solved: Solved) -> None:
     plan = planned("lab_sim", 0, 2)
     trace = solved[("lab_sim", 0, 2)].joint_trace
     n = len(plan.trajectory.t)

@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
-
-os.environ.setdefault("MUJOCO_GL", "egl")  # headless offscreen rendering; read when mujoco is first imported
 
 import mujoco
 import numpy as np

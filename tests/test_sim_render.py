@@ -2,10 +2,7 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
-
-os.environ.setdefault("MUJOCO_GL", "egl")  # headless offscreen rendering; read when mujoco is first imported
 
 import pytest
 

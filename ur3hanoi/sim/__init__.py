@@ -10,11 +10,12 @@ Modules, in order of dependency (each imports only the ones above it):
   :func:`build_task_spec`, :func:`build_task_scene`, :class:`TaskScene`), the blocks' start slots and names.
 - :mod:`~ur3hanoi.sim.suction`: the emulated vacuum gripper and its ``gripper_input`` feedback
   (:class:`SuctionConfig`, :class:`SuctionCup`, :class:`GripperInput`).
+- :mod:`~ur3hanoi.sim.halt`: the motion of a halt (:class:`HaltProfile`, :data:`DEFAULT_HALT_PROFILE`: Ruckig).
 - :mod:`~ur3hanoi.sim.result`: what a run reports (:class:`SimResult`, :class:`FeedbackEvent`,
   :class:`FinalBlock`, :class:`JointTrace`).
 - :mod:`~ur3hanoi.sim.executor`: :func:`run_plan` streams a :class:`ur3hanoi.plan.Plan`, checks the suction like
   the lab program, halts on a fault (raising :class:`ur3hanoi.errors.SuctionFaultError` with the result) and
-  verifies the final block positions (:class:`Faults`, :class:`SimConfig`, :class:`HaltProfile`).
+  verifies the final block positions (:class:`Faults`, :class:`SimConfig`).
 - :mod:`~ur3hanoi.sim.render`: offscreen frames/video and the interactive viewer (:class:`CameraConfig`,
   :class:`OffscreenRecorder`, :class:`ViewerSink`, :func:`display_available`).
 
@@ -25,7 +26,8 @@ Joint values are the controller/DH convention (they equal the URDF's, see :mod:`
 Numbering: internally 0-based (towers, heights, blocks, moves); messages and JSON are 1-based like the lab.
 """
 
-from ur3hanoi.sim.executor import Faults, FrameSink, HaltProfile, ProgressFn, SimConfig, run_plan
+from ur3hanoi.sim.executor import Faults, FrameSink, ProgressFn, SimConfig, run_plan
+from ur3hanoi.sim.halt import DEFAULT_HALT_PROFILE, HaltProfile
 from ur3hanoi.sim.model import (
     DRIVES,
     ROBOT_DIR,
@@ -51,6 +53,7 @@ from ur3hanoi.sim.scene import (
 from ur3hanoi.sim.suction import GripperInput, SuctionConfig, SuctionCup
 
 __all__ = [
+    "DEFAULT_HALT_PROFILE",
     "DRIVES",
     "ROBOT_DIR",
     "SCENE_XML",

@@ -8,7 +8,8 @@ halt on a fault, and verify the final block positions from the simulation state.
 2. **suction check** (:meth:`_Run.check_suction`, every cycle of step 1): a block must be held at the end of every
    GRASP_DWELL and in every cycle of a carrying phase, else streaming stops with a fault;
 3. **halt** (:meth:`_Run.halt`, after a fault): decelerate to rest from the reference state (jerk-limited, no
-   jump), suction off, vent, return home; or, without a fault, hold the plan's last sample (:meth:`_Run.settle`);
+   jump: :mod:`ur3hanoi.sim.halt`), suction off, vent, return home; then, as without a fault, hold the final
+   pose while the blocks settle (:meth:`_Run.settle`);
 4. **final verification** (:meth:`_Run.result`): where every block is, whether the arm is home and the suction off.
 
 After a halt :func:`run_plan` raises :class:`ur3hanoi.errors.SuctionFaultError` carrying the :class:`SimResult`
@@ -28,18 +29,16 @@ from typing import Protocol
 
 import mujoco
 import numpy as np
-from ruckig import ControlInterface, InputParameter, Result, Ruckig
-from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import SimulationError, SuctionFaultError
 from ur3hanoi.hanoi import block_colour
 from ur3hanoi.plan import Phase, Plan, Trajectory
 from ur3hanoi.robot import JOINT_NAMES, N_JOINTS
+from ur3hanoi.sim.halt import DEFAULT_HALT_PROFILE, HaltProfile
 from ur3hanoi.sim.result import FeedbackEvent, FinalBlock, JointTrace, SimResult
 from ur3hanoi.sim.scene import SceneConfig, TaskScene, build_task_scene, slot_centers, warning_counts
 from ur3hanoi.sim.suction import GripperInput, SuctionConfig, SuctionCup
-from ur3hanoi.station import Station
 
 
 @dataclass(frozen=True)
@@ -82,49 +81,6 @@ class FrameSink(Protocol):
 
 
 ProgressFn = Callable[[float, str], None]
-
-
-class HaltProfile(Protocol):
-    """The motion of a halt: samples (q, qd, qdd), each (n, 6) [rad, rad/s, rad/s^2], every ``dt`` [s] from the
-    state (q0, v0, a0) to rest (``target_q`` None) or to rest at ``target_q``, within the station's limits with
-    the velocity scaled by ``speed``. The first sample is ``dt`` after the start state.
-
-    :func:`run_plan` uses a jerk-limited Ruckig profile; another profile can be passed to ``run_plan(halt=...)``
-    (e.g. to check that a halt without one is caught by the continuity checks of the tests).
-    """
-
-    def __call__(self, q0: FloatArray, v0: FloatArray, a0: FloatArray, station: Station, speed: float, dt: float,
-                 target_q: FloatArray | None) -> tuple[FloatArray, FloatArray, FloatArray]: ...
-
-
-def _ruckig_samples(q0: FloatArray, v0: FloatArray, a0: FloatArray, station: Station, speed: float, dt: float,
-                    target_q: FloatArray | None) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Jerk-limited samples (q, qd, qdd) every ``dt`` [s] from a state to rest (``target_q`` None) or to a pose."""
-    lim = station.limits
-    otg = Ruckig(N_JOINTS)
-    inp = InputParameter(N_JOINTS)
-    inp.current_position = list(q0)
-    inp.current_velocity = list(v0)
-    inp.current_acceleration = list(a0)
-    inp.target_velocity = [0.0] * N_JOINTS
-    inp.target_acceleration = [0.0] * N_JOINTS
-    inp.max_velocity = [speed * v for v in lim.v_max]
-    # Stopping uses the full acceleration/jerk budget even at reduced speed: the arm must come to rest soon.
-    inp.max_acceleration = list(lim.a_max)
-    inp.max_jerk = list(lim.j_max)
-    if target_q is None:
-        inp.control_interface = ControlInterface.Velocity
-        inp.target_position = list(q0)
-    else:
-        inp.target_position = list(target_q)
-    traj = RuckigTrajectory(N_JOINTS)
-    if otg.calculate(inp, traj) not in (Result.Working, Result.Finished):
-        raise SimulationError("Ruckig could not plan the halt trajectory")
-    n = max(1, math.ceil(traj.duration / dt))
-    qs, vs, accs = np.empty((n, N_JOINTS)), np.empty((n, N_JOINTS)), np.empty((n, N_JOINTS))
-    for i in range(n):
-        qs[i], vs[i], accs[i] = traj.at_time(min((i + 1) * dt, traj.duration))
-    return qs, vs, accs
 
 
 def _slot_of(centers: FloatArray, xyz: FloatArray, tol: float) -> tuple[int, int] | None:
@@ -438,7 +394,8 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
         progress: called with (fraction done, label) about 50 times per run.
         scene: a pre-built scene (must match the plan).
         realtime: pace the loop to wall-clock time (for the interactive viewer).
-        halt: the motion profile of a halt (None: jerk-limited Ruckig, see :class:`HaltProfile`).
+        halt: the motion profile of a halt (None: :data:`~ur3hanoi.sim.halt.DEFAULT_HALT_PROFILE`, jerk-limited
+            Ruckig; see :class:`~ur3hanoi.sim.halt.HaltProfile`).
 
     Returns:
         the result, "solved" or "failed" (the final positions do not match the plan).
@@ -457,7 +414,7 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
 
     fault = run.stream_plan()
     if fault is not None:
-        q_final_ref = run.halt(fault, halt if halt is not None else _ruckig_samples)
+        q_final_ref = run.halt(fault, halt if halt is not None else DEFAULT_HALT_PROFILE)
     else:
         q_final_ref = tr.q[-1]
         run.cup.command(bool(tr.suction[-1]))
