@@ -18,8 +18,9 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from ur3hanoi.plan import plan_solve  # noqa: E402
 from ur3hanoi.resources import stations_dir  # noqa: E402
-from ur3hanoi.sim import make_plan, run_plan  # noqa: E402
+from ur3hanoi.sim import run_plan  # noqa: E402
 from ur3hanoi.station import load_station  # noqa: E402
 
 
@@ -30,7 +31,7 @@ def main() -> int:
     for name in ("lab_sim", "lab_real"):
         st = load_station(stations_dir() / f"{name}.yaml")
         t0 = time.perf_counter()
-        plan = make_plan(st, 0, 2, 3)
+        plan = plan_solve(st, 0, 2, 3)
         t_plan = time.perf_counter() - t0
         rtfs, errs = [], []
         for _ in range(args.repeat):

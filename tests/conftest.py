@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
 
 from ur3hanoi.resources import stations_dir
 from ur3hanoi.station import Station, load_station
+
+# Headless offscreen rendering. MuJoCo reads it when first imported, i.e. while the first test module importing
+# ur3hanoi.sim is collected: it must be set before any of them.
+os.environ.setdefault("MUJOCO_GL", "egl")
 
 REPO = Path(__file__).resolve().parents[1]
 LAB_SIM = stations_dir() / "lab_sim.yaml"

@@ -236,7 +236,8 @@ def _run_solve(args: argparse.Namespace) -> int:
     if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
         os.environ["MUJOCO_GL"] = "egl"  # headless offscreen rendering (read when the GL context is created)
 
-    from ur3hanoi.plan import PlanConfig
+    from ur3hanoi.errors import SuctionFaultError
+    from ur3hanoi.plan import PlanConfig, plan_solve
     from ur3hanoi.sim import (
         Faults,
         OffscreenRecorder,
@@ -244,18 +245,18 @@ def _run_solve(args: argparse.Namespace) -> int:
         ViewerSink,
         build_task_scene,
         display_available,
-        make_plan,
         run_plan,
     )
 
     if args.view and display_available() is not None:
-        raise Ur3HanoiError(f"--view cannot open the MuJoCo viewer: {display_available()}")
+        raise Ur3HanoiError(f"--view cannot open the MuJoCo viewer: {display_available()}; "
+                            "use --video FILE.mp4 or --frames DIR")
     faults = Faults(
         remove_block=None if args.remove_block is None else args.remove_block - 1,
         drop_during_move=None if args.drop_during_move is None else args.drop_during_move - 1,
     )
     config = SimConfig(seed=args.seed)
-    plan = make_plan(station, start, end, n_blocks, PlanConfig(speed=args.speed))
+    plan = plan_solve(station, start, end, n_blocks, PlanConfig(speed=args.speed))
     scene = build_task_scene(station, start, n_blocks, faults.remove_block, config.scene)
     sink: object | None = None
     try:
@@ -265,8 +266,14 @@ def _run_solve(args: argparse.Namespace) -> int:
             sink = OffscreenRecorder(station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
                                      video=Path(args.video) if args.video else None)
         progress = _solve_progress if sys.stderr.isatty() and not args.view else None
-        result = run_plan(plan, faults, config, frames=sink, progress=progress,  # type: ignore[arg-type]
-                          scene=scene, realtime=args.view)
+        fault: SuctionFaultError | None = None
+        try:
+            result = run_plan(plan, faults, config, frames=sink, progress=progress,  # type: ignore[arg-type]
+                              scene=scene, realtime=args.view)
+        except SuctionFaultError as exc:
+            if exc.result is None:
+                raise
+            result, fault = exc.result, exc  # print the outcome, then report the fault (exit 3)
     finally:
         if sink is not None:
             sink.close()  # type: ignore[attr-defined]
@@ -285,6 +292,8 @@ def _run_solve(args: argparse.Namespace) -> int:
               f"{'on' if result.suction_on_at_end else 'off'}, {'at' if result.at_home_at_end else 'not at'} home")
         if args.video or args.frames:
             print(f"  wrote {sink.count} frames to {args.video or args.frames}")  # type: ignore[union-attr]
+    if fault is not None:
+        raise fault
     if result.error is not None:
         print(f"ur3hanoi: error: {result.error}", file=sys.stderr)
     return result.exit_code

@@ -6,6 +6,11 @@ and what would have been valid, so the CLI can print ``str(error)`` and exit wit
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # typing only: importing ur3hanoi.sim at run time would load MuJoCo and the planner
+    from ur3hanoi.sim.result import SimResult
+
 
 class Ur3HanoiError(Exception):
     """Base class of every user-facing error. The CLI prints it on one line and exits with ``exit_code``."""
@@ -49,6 +54,14 @@ class SimulationError(Ur3HanoiError):
 
 
 class SuctionFaultError(Ur3HanoiError):
-    """Suction feedback says no block is held where one should be (the lab's halt condition)."""
+    """Suction feedback says no block is held where one should be (the lab's halt condition).
+
+    Raised after the halt (arm stopped, suction off, arm home); ``result`` is the simulator's outcome of the run
+    (status "halted") when the fault comes from :func:`ur3hanoi.sim.run_plan`, else None.
+    """
 
     exit_code = 3
+
+    def __init__(self, message: str, result: SimResult | None = None) -> None:
+        super().__init__(message)
+        self.result = result

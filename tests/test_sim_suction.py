@@ -1,0 +1,83 @@
+"""ur3hanoi.sim.suction: grasping by weld within the lab's radius, and the emulated gripper_input feedback."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from ur3hanoi.sim import SuctionConfig, SuctionCup, TaskScene, build_task_scene
+from ur3hanoi.table import generate_table
+
+from .sim_helpers import STATIONS
+
+
+def scene_at_contact(name: str, offset: np.ndarray | None = None) -> TaskScene:
+    """Arm at the "on" pose of tower 0 / top block, optionally with that block shifted by ``offset`` [m]."""
+    station = STATIONS[name]
+    scene = build_task_scene(station, 0, 3)
+    q_on = generate_table(station).q[0, 2, 0]
+    scene.data.qpos[scene.arm_qadr] = q_on
+    scene.data.ctrl[:6] = q_on
+    if offset is not None:
+        adr = scene.block_qadr[2]
+        scene.data.qpos[adr:adr + 3] += offset
+    mujoco.mj_forward(scene.model, scene.data)
+    return scene
+
+
+@pytest.mark.parametrize("name", STATIONS)
+def test_suction_grasps_without_jump_and_reports_feedback(name: str) -> None:
+    scene = scene_at_contact(name)
+    cup = SuctionCup(scene, seed=1)
+    assert not cup.feedback().held and abs(cup.feedback().ain0 - 1.05) < 0.05
+    before = scene.block_pos(2)
+    cup.command(True)
+    cup.update()
+    assert cup.attached == 2
+    mujoco.mj_step(scene.model, scene.data, nstep=50)
+    assert np.linalg.norm(scene.block_pos(2) - before) < 5e-4  # the weld starts at the current relative pose
+    fb = cup.feedback()
+    assert fb.digin == 1 and abs(fb.ain0 - 1.9) < 0.05
+    cup.command(False)
+    fb = cup.feedback()
+    assert fb.digin == 0 and abs(fb.ain0 - 1.05) < 0.05 and cup.attached is None
+
+
+@pytest.mark.parametrize(("dist", "grasped"), [(0.009, True), (0.011, False)])
+def test_grasp_radius_is_measured_from_the_contact_suction_point(dist: float, grasped: bool) -> None:
+    scene = scene_at_contact("lab_sim", offset=np.array([dist, 0.0, 0.0]))
+    cup = SuctionCup(scene)
+    cup.command(True)
+    cup.update()
+    assert (cup.attached == 2) is grasped
+    fb = cup.feedback()
+    assert fb.held is grasped and abs(fb.ain0 - (1.9 if grasped else 1.45)) < 0.05
+
+
+def test_lost_block_reads_as_not_held_while_suction_stays_on() -> None:
+    cup = SuctionCup(scene_at_contact("lab_sim"), SuctionConfig(ain_noise=0.0))
+    cup.command(True)
+    cup.update()
+    assert cup.feedback().held
+    assert cup.lose_block() == 2
+    fb = cup.feedback()
+    assert cup.on and not fb.held and fb.ain0 == 1.45
+
+
+def test_disabled_grasp_picks_nothing_up() -> None:
+    cup = SuctionCup(scene_at_contact("lab_sim"))
+    cup.grasp_enabled = False  # what the executor does while halting
+    cup.command(True)
+    cup.update()
+    assert cup.attached is None and not cup.feedback().held
+
+
+def test_seeded_noise_is_reproducible_and_seed_dependent() -> None:
+    def ain0(seed: int) -> list[float]:
+        cup = SuctionCup(scene_at_contact("lab_sim"), seed=seed)
+        return [cup.feedback().ain0 for _ in range(5)]
+
+    assert ain0(3) == ain0(3)
+    assert ain0(3) != ain0(4)
+    assert max(abs(v - 1.05) for v in ain0(3)) < 0.05  # 0.01 V noise around the suction-off level

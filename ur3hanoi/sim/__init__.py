@@ -1,0 +1,90 @@
+"""Run the lab in MuJoCo: the UR3 model, the task scene, suction with feedback, plan execution with the lab's
+fault handling, and rendering.
+
+Modules, in order of dependency (each imports only the ones above it):
+
+- :mod:`~ur3hanoi.sim.model`: ``robots/universal_robots_ur3/ur3.xml`` derived from example-robot-data's
+  ``ur3_robot.urdf`` (:func:`derive_ur3_mjcf`, :func:`write_ur3_files`; ``python -m ur3hanoi.sim`` regenerates
+  it), the joint drives (:class:`JointDrive`, :data:`DRIVES`).
+- :mod:`~ur3hanoi.sim.scene`: the station's task scene built with :class:`mujoco.MjSpec` (:class:`SceneConfig`,
+  :func:`build_task_spec`, :func:`build_task_scene`, :class:`TaskScene`), the blocks' start slots and names.
+- :mod:`~ur3hanoi.sim.suction`: the emulated vacuum gripper and its ``gripper_input`` feedback
+  (:class:`SuctionConfig`, :class:`SuctionCup`, :class:`GripperInput`).
+- :mod:`~ur3hanoi.sim.halt`: the motion of a halt (:class:`HaltProfile`, :data:`DEFAULT_HALT_PROFILE`: Ruckig).
+- :mod:`~ur3hanoi.sim.result`: what a run reports (:class:`SimResult`, :class:`FeedbackEvent`,
+  :class:`FinalBlock`, :class:`JointTrace`).
+- :mod:`~ur3hanoi.sim.executor`: :func:`run_plan` streams a :class:`ur3hanoi.plan.Plan`, checks the suction like
+  the lab program, halts on a fault (raising :class:`ur3hanoi.errors.SuctionFaultError` with the result) and
+  verifies the final block positions (:class:`Faults`, :class:`SimConfig`).
+- :mod:`~ur3hanoi.sim.render`: offscreen frames/video and the interactive viewer (:class:`CameraConfig`,
+  :class:`OffscreenRecorder`, :class:`ViewerSink`, :func:`display_available`).
+
+Frames: MuJoCo's world is the station's world. The URDF root ``base_link`` is placed at
+``T_world_base * Rz(pi)`` so that MuJoCo's ``suction`` site equals ``T_world_base * Ur3Model.fk(q, "tcp")``.
+Joint values are the controller/DH convention (they equal the URDF's, see :mod:`ur3hanoi.robot`).
+
+Numbering: internally 0-based (towers, heights, blocks, moves); messages and JSON are 1-based like the lab.
+"""
+
+from ur3hanoi.sim.executor import Faults, FrameSink, ProgressFn, SimConfig, run_plan
+from ur3hanoi.sim.halt import DEFAULT_HALT_PROFILE, HaltProfile
+from ur3hanoi.sim.model import (
+    DRIVES,
+    ROBOT_DIR,
+    SCENE_XML,
+    UR3_XML,
+    JointDrive,
+    derive_ur3_mjcf,
+    ur3_mesh_sources,
+    write_ur3_files,
+)
+from ur3hanoi.sim.render import CameraConfig, OffscreenRecorder, ViewerSink, display_available
+from ur3hanoi.sim.result import FeedbackEvent, FinalBlock, JointTrace, SimResult
+from ur3hanoi.sim.scene import (
+    SceneConfig,
+    TaskScene,
+    block_name,
+    build_task_scene,
+    build_task_spec,
+    slot_centers,
+    start_slots,
+    warning_counts,
+)
+from ur3hanoi.sim.suction import GripperInput, SuctionConfig, SuctionCup
+
+__all__ = [
+    "DEFAULT_HALT_PROFILE",
+    "DRIVES",
+    "ROBOT_DIR",
+    "SCENE_XML",
+    "UR3_XML",
+    "CameraConfig",
+    "Faults",
+    "FeedbackEvent",
+    "FinalBlock",
+    "FrameSink",
+    "GripperInput",
+    "HaltProfile",
+    "JointDrive",
+    "JointTrace",
+    "OffscreenRecorder",
+    "ProgressFn",
+    "SceneConfig",
+    "SimConfig",
+    "SimResult",
+    "SuctionConfig",
+    "SuctionCup",
+    "TaskScene",
+    "ViewerSink",
+    "block_name",
+    "build_task_scene",
+    "build_task_spec",
+    "derive_ur3_mjcf",
+    "display_available",
+    "run_plan",
+    "slot_centers",
+    "start_slots",
+    "ur3_mesh_sources",
+    "warning_counts",
+    "write_ur3_files",
+]

@@ -1,0 +1,138 @@
+"""The lab's vacuum gripper, emulated: suction on/off, grasping by weld equality, and the ``gripper_input`` feedback.
+
+:class:`SuctionCup` follows the course's Gazebo plugin rule adapted to a weld: when the suction is on and the
+suction point is within ``grasp_radius`` of where it would be at contact with a block, that block's weld equality
+(added by :func:`ur3hanoi.sim.build_task_spec`) is activated at the current relative pose. :class:`GripperInput`
+is the emulated ``ur3/gripper_input`` sample (``DIGIN`` bit 0 = block held, ``AIN0`` [V], seeded noise).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from ur3hanoi.arrays import FloatArray
+from ur3hanoi.sim.scene import TaskScene
+
+
+@dataclass(frozen=True)
+class SuctionConfig:
+    """Emulated vacuum gripper (the course's Gazebo plugin rule, adapted to a weld).
+
+    Attributes:
+        grasp_radius: a block is grasped when suction is on and the suction point is within this distance [m] of
+            the block's expected suction point at contact: top-face centre minus ``contact_depth`` along world z
+            (the lab rule: within 0.01 m of the grasp point; measured against the contact point because the
+            calibrations put the suction point ``contact_depth`` below the top face).
+        hold_tolerance: a welded block counts as held while its expected suction point is within this
+            distance [m] of the suction point (a weld stretched further means it is being torn off).
+        ain_holding, ain_on_empty, ain_off: ``AIN0`` [V] holding a block, suction on with nothing held, suction
+            off (the course simulator's values).
+        ain_noise: standard deviation [V] of the seeded Gaussian noise on ``AIN0``.
+    """
+
+    grasp_radius: float = 0.01
+    hold_tolerance: float = 0.01
+    ain_holding: float = 1.9
+    ain_on_empty: float = 1.45
+    ain_off: float = 1.05
+    ain_noise: float = 0.01
+
+
+@dataclass(frozen=True)
+class GripperInput:
+    """One ``ur3/gripper_input`` sample: ``DIGIN`` bit 0 = block held, ``AIN0`` [V], at sim time ``t`` [s]."""
+
+    t: float
+    digin: int
+    ain0: float
+
+    @property
+    def held(self) -> bool:
+        return bool(self.digin & 1)
+
+
+class SuctionCup:
+    """Suction on/off, grasping by weld equality, drop injection and the ``gripper_input`` feedback."""
+
+    def __init__(self, scene: TaskScene, config: SuctionConfig | None = None, seed: int = 0) -> None:
+        self.scene = scene
+        self.config = config if config is not None else SuctionConfig()
+        self.rng = np.random.default_rng(seed)
+        self.on = False
+        self.attached: int | None = None
+        self.grasp_enabled = True  # cleared while halting: a faulted cup must not pick anything up
+        st = scene.station
+        # Block centre -> suction point at contact; constant, and read every control cycle by held().
+        self._contact_offset = np.array([0.0, 0.0, 0.5 * st.block_size - st.contact_depth])
+        m = scene.model
+        for eq in scene.block_eq.values():
+            m.eq_data[eq, 11] = 0.0  # use the relative pose written below, not one computed from qpos0
+
+    def expected_suction_point(self, block: int) -> FloatArray:
+        """Where the suction point sits at contact with ``block``: top-face centre minus contact_depth [m, world]."""
+        return self.scene.block_pos(block) + self._contact_offset
+
+    def command(self, on: bool) -> None:
+        """Set the suction valve (``io_0``); turning it off releases any block."""
+        if not on and self.attached is not None:
+            self._detach()
+        self.on = bool(on)
+
+    def update(self) -> None:
+        """Grasp the nearest block within ``grasp_radius`` when on and empty (called every control cycle)."""
+        if not self.on or self.attached is not None or not self.grasp_enabled:
+            return
+        p_cup = self.scene.data.site_xpos[self.scene.site_id]
+        best, best_d = None, self.config.grasp_radius
+        for b in self.scene.block_body:
+            d = float(np.linalg.norm(self.expected_suction_point(b) - p_cup))
+            if d <= best_d:
+                best, best_d = b, d
+        if best is not None:
+            self._attach(best)
+
+    def _attach(self, block: int) -> None:
+        # Write the current relative pose (block in cup) before activating, or the weld pulls the block by
+        # the stale offset.
+        d, m = self.scene.data, self.scene.model
+        c, k = self.scene.cup_body, self.scene.block_body[block]
+        R_c = d.xmat[c].reshape(3, 3)
+        rel_pos = R_c.T @ (d.xpos[k] - d.xpos[c])
+        conj_c, rel_quat = np.empty(4), np.empty(4)
+        mujoco.mju_negQuat(conj_c, d.xquat[c])
+        mujoco.mju_mulQuat(rel_quat, conj_c, d.xquat[k])
+        eq = self.scene.block_eq[block]
+        m.eq_data[eq, 0:3] = 0.0
+        m.eq_data[eq, 3:6] = rel_pos
+        m.eq_data[eq, 6:10] = rel_quat
+        d.eq_active[eq] = 1
+        self.attached = block
+
+    def _detach(self) -> None:
+        assert self.attached is not None
+        self.scene.data.eq_active[self.scene.block_eq[self.attached]] = 0
+        self.attached = None
+
+    def lose_block(self) -> int | None:
+        """Fault injection: the seal breaks and the held block falls while the suction stays on."""
+        block = self.attached
+        if block is not None:
+            self._detach()
+        return block
+
+    def held(self) -> bool:
+        if not self.on or self.attached is None:
+            return False
+        p_cup = self.scene.data.site_xpos[self.scene.site_id]
+        return float(np.linalg.norm(self.expected_suction_point(self.attached) - p_cup)) <= self.config.hold_tolerance
+
+    def feedback(self) -> GripperInput:
+        """The emulated ``gripper_input`` now (seeded noise on ``AIN0``)."""
+        c = self.config
+        held = self.held()
+        volts = c.ain_holding if held else (c.ain_on_empty if self.on else c.ain_off)
+        volts += float(self.rng.normal(0.0, c.ain_noise)) if c.ain_noise > 0 else 0.0
+        return GripperInput(t=float(self.scene.data.time), digin=int(held), ain0=volts)
