@@ -130,10 +130,35 @@ def test_remove_block_halts_before_any_further_placement(height: int) -> None:
     assert r.warnings == {}
 
 
-def test_remove_block_stacked_halts_at_the_first_pick() -> None:
-    r = run_faulty(("lab_real", 0, 2), Faults(remove_block=0))
+@pytest.mark.parametrize("height", [1, 2, 3])
+def test_remove_block_stacked_names_the_block_that_is_missing(height: int) -> None:
+    # Stacked: the blocks above the removed one rest one level lower, so the first pick (the top, red) finds
+    # nothing whichever block was removed; the message must name the removed block, not the red one.
+    r = run_faulty(("lab_real", 0, 2), Faults(remove_block=height - 1))
     assert r.status == "halted" and r.exit_code == 3 and r.moves_completed == 0 and r.fault_move == 0
     assert not r.suction_on_at_end and r.at_home_at_end
+    assert r.fault_block == height - 1
+    colour = ("green", "yellow", "red")[height - 1]
+    msg = r.error or ""
+    assert f"{colour} block {height} is missing" in msg and f"tower 1 height {height}" in msg, msg
+    for other in {1, 2, 3} - {height}:  # the blocks still there are not called missing
+        assert f"block {other} is missing" not in msg, msg
+
+
+def test_a_block_knocked_by_the_dropped_one_is_reported_after_the_halt() -> None:
+    # Measured: lab_sim, tower 2 -> 3, the red block dropped in move 7 lands on the yellow one (placed in move 6)
+    # and pushes it about 3 mm: within the 5 mm "at its slot" tolerance, so only the displacement shows it.
+    r = run_faulty(("lab_sim", 1, 2), Faults(drop_during_move=6))
+    knocked = {d.block: d for d in r.displaced_blocks}
+    assert set(knocked) == {1}, r.displaced_blocks
+    assert 0.001 < knocked[1].moved_m < 0.005 and (knocked[1].tower, knocked[1].height) == (2, 1)
+    assert "yellow block 2 was knocked" in (r.error or "") and "tower 3 height 2" in (r.error or "")
+    assert r.as_dict()["fault"]["displaced_blocks"][0]["block"] == 2
+
+
+def test_no_block_is_reported_knocked_when_none_was_hit() -> None:
+    r = run_faulty(("lab_sim", 0, 2), Faults(drop_during_move=0))
+    assert r.displaced_blocks == () and "knocked" not in (r.error or "")
 
 
 @pytest.mark.parametrize(("name", "move"), [("lab_sim", 1), ("lab_sim", 4), ("lab_real", 7)])

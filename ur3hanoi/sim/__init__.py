@@ -39,7 +39,7 @@ from ur3hanoi.sim.model import (
     write_ur3_files,
 )
 from ur3hanoi.sim.render import CameraConfig, OffscreenRecorder, ViewerSink, display_available
-from ur3hanoi.sim.result import FeedbackEvent, FinalBlock, JointTrace, SimResult
+from ur3hanoi.sim.result import DisplacedBlock, FeedbackEvent, FinalBlock, JointTrace, SimResult
 from ur3hanoi.sim.scene import (
     SceneConfig,
     TaskScene,
@@ -59,6 +59,7 @@ __all__ = [
     "SCENE_XML",
     "UR3_XML",
     "CameraConfig",
+    "DisplacedBlock",
     "Faults",
     "FeedbackEvent",
     "FinalBlock",

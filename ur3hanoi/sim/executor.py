@@ -32,11 +32,11 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import SimulationError, SuctionFaultError
-from ur3hanoi.hanoi import block_colour
+from ur3hanoi.hanoi import block_colour, stacks_before_moves
 from ur3hanoi.plan import Phase, Plan, Trajectory
 from ur3hanoi.robot import JOINT_NAMES, N_JOINTS
 from ur3hanoi.sim.halt import DEFAULT_HALT_PROFILE, HaltProfile
-from ur3hanoi.sim.result import FeedbackEvent, FinalBlock, JointTrace, SimResult
+from ur3hanoi.sim.result import DisplacedBlock, FeedbackEvent, FinalBlock, JointTrace, SimResult
 from ur3hanoi.sim.scene import SceneConfig, TaskScene, build_task_scene, slot_centers, warning_counts
 from ur3hanoi.sim.suction import GripperInput, SuctionConfig, SuctionCup
 
@@ -61,6 +61,8 @@ class SimConfig:
         home_tolerance: "at home" when every joint is within this angle [rad] of the home pose.
         halt_speed: fraction of the joint limits used to stop and to return home after a fault.
         settle_s: time [s] simulated at rest after the last sample (blocks settle, the servo converges).
+        knock_tolerance: after a halt, a block that rested when the fault was detected and has since moved
+            farther than this [m] was knocked (e.g. by the dropped block) and is reported.
     """
 
     scene: SceneConfig = field(default_factory=SceneConfig)
@@ -70,6 +72,7 @@ class SimConfig:
     home_tolerance: float = 0.01
     halt_speed: float = 0.5
     settle_s: float = 0.3
+    knock_tolerance: float = 0.001
 
 
 class FrameSink(Protocol):
@@ -94,13 +97,24 @@ def _slot_of(centers: FloatArray, xyz: FloatArray, tol: float) -> tuple[int, int
 
 @dataclass(frozen=True)
 class _Fault:
-    """A failed suction check: at plan sample ``k``, sim time ``t`` [s] (0-based move and block)."""
+    """A failed suction check: at plan sample ``k``, sim time ``t`` [s] (0-based move and block).
+
+    ``resting`` holds the position [m, world] of every block that rested in the scene when the fault was detected
+    (all but the one lost from the cup), to find the blocks knocked out of place afterwards.
+    """
 
     move: int
     block: int
     message: str
     t: float
     k: int
+    resting: dict[int, FloatArray] = field(default_factory=dict)
+
+
+def _slot_text(slot: tuple[int, int] | None, xyz: FloatArray) -> str:
+    if slot is None:
+        return f"in no slot at {np.round(xyz, 4).tolist()} m"
+    return f"at tower {slot[0] + 1} height {slot[1] + 1}"
 
 
 def _validate(plan: Plan, faults: Faults) -> tuple[int, int]:
@@ -269,17 +283,56 @@ class _Run:
             move = moves[mv]
             kind = "missing" if dwell_end else "dropped"
             self.events.append(FeedbackEvent(fb.t, kind, mv, move.block, fb.digin, fb.ain0))
-            where = (f"at tower {move.from_tower + 1} height {move.from_height + 1}" if kind == "missing"
-                     else f"while carrying it from tower {move.from_tower + 1} to tower {move.to_tower + 1}")
-            msg = (f"suction fault in move {mv + 1}/{len(moves)}: {block_colour(move.block)} block {move.block + 1} "
-                   f"{'is missing' if kind == 'missing' else 'was dropped'} {where} (DIGIN={fb.digin}, "
-                   f"AIN0={fb.ain0:.2f} V); halted, suction off, arm returned home")
-            return _Fault(mv, move.block, msg, fb.t, k)
+            sensed = f"(DIGIN={fb.digin}, AIN0={fb.ain0:.2f} V)"
+            block = move.block
+            if kind == "dropped":
+                what = (f"{block_colour(block)} block {block + 1} was dropped while carrying it from tower "
+                        f"{move.from_tower + 1} to tower {move.to_tower + 1} {sensed}")
+            else:
+                block, what = self._diagnose_missing(mv, sensed)
+            msg = f"suction fault in move {mv + 1}/{len(moves)}: {what}; halted, suction off, arm returned home"
+            resting = {b: self.scene.block_pos(b) for b in self.scene.block_body if kind == "missing" or b != block}
+            return _Fault(mv, block, msg, fb.t, k, resting)
         if dwell_end:
             cup = self.cup
             self.events.append(FeedbackEvent(fb.t, "grasp", mv, cup.attached if cup.attached is not None else -1,
                                              fb.digin, fb.ain0))
         return None
+
+    def _diagnose_missing(self, mv: int, sensed: str) -> tuple[int, str]:
+        """Why nothing was picked in move ``mv``: the block actually missing, read from the simulation state.
+
+        The plan expects every block in the slot the moves so far put it in. A block absent from the scene, or in
+        no slot, is the missing one; in a stacked tower the blocks above a missing one rest one level lower, so
+        the block the move wanted to pick is usually not the missing one. Returns (missing block, message part).
+        """
+        moves, scene = self.plan.moves, self.scene
+        move = moves[mv]
+        n_blocks = max(m.block for m in moves) + 1
+        stacks = stacks_before_moves(moves, n_blocks, moves[0].from_tower, self.plan.station.n_towers)[mv]
+        expected = {b: (t, h) for t, stack in enumerate(stacks) for h, b in enumerate(stack)}
+        centers = slot_centers(self.plan.station)
+        absent = [b for b in sorted(expected) if b not in scene.block_body]
+        if absent == [move.block]:  # the block to pick is the one that is gone: the plain message says it all
+            return move.block, (f"{block_colour(move.block)} block {move.block + 1} is missing at tower "
+                                f"{move.from_tower + 1} height {move.from_height + 1} {sensed}")
+        displaced = []
+        for b in sorted(scene.block_body):
+            xyz = scene.block_pos(b)
+            slot = _slot_of(centers, xyz, self.cfg.place_tolerance)
+            if slot != expected[b]:
+                displaced.append((b, slot, xyz))
+        absent += [b for b, slot, _ in displaced if slot is None]
+        missing = absent[0] if absent else move.block
+        t, h = expected[missing]
+        where = f"tower {t + 1} height {h + 1}"
+        text = (f"no block to pick at tower {move.from_tower + 1} height {move.from_height + 1}, where "
+                f"{block_colour(move.block)} block {move.block + 1} should be {sensed}: ")
+        text += (f"{block_colour(missing)} block {missing + 1} is missing from {where}" if absent else
+                 f"{block_colour(missing)} block {missing + 1} is not there")
+        found = [f"{block_colour(b)} block {b + 1} is {_slot_text(slot, xyz)}" for b, slot, xyz in displaced
+                 if slot is not None]
+        return missing, text + (f" ({', '.join(found)})" if found else "")
 
     # ------------------------------------------------------------------------------------------ 3. halt / settle
 
@@ -338,10 +391,23 @@ class _Run:
         return JointTrace(t=np.array(t), q_ref=q_ref, qd_ref=qd_ref, qdd_ref=qdd_ref, q=np.array(q),
                           qd=np.array(qd), halt_start=self.halt_start, settle_start=settle_start)
 
+    def displaced_blocks(self, fault: _Fault) -> list[DisplacedBlock]:
+        """The blocks that rested when ``fault`` was detected and moved farther than ``knock_tolerance`` since."""
+        out = []
+        centers = slot_centers(self.plan.station)
+        for b, before in sorted(fault.resting.items()):
+            moved = float(np.linalg.norm(self.scene.block_pos(b) - before))
+            if moved > self.cfg.knock_tolerance:
+                slot = _slot_of(centers, before, self.cfg.place_tolerance)
+                out.append(DisplacedBlock(b, None if slot is None else slot[0], None if slot is None else slot[1],
+                                          moved))
+        return out
+
     def result(self, fault: _Fault | None, wall: float, settle_start: int) -> SimResult:
         """The outcome: final block positions, arm and suction state, and the status the checks give."""
         cfg, st, moves, cup = self.cfg, self.plan.station, self.plan.moves, self.cup
         final = self.final_blocks()
+        displaced: list[DisplacedBlock] = []
         at_home = bool(np.max(np.abs(self.scene.arm_q() - st.q_home_array)) <= cfg.home_tolerance)
         end_tower = moves[-1].to_tower if fault is None else None
         mv: int | None
@@ -350,6 +416,9 @@ class _Run:
             mv, block, msg, t_det = fault.move, fault.block, fault.message, fault.t
             latency = None if self.drop_time is None else t_det - self.drop_time
             status, code, error = "halted", SuctionFaultError.exit_code, msg
+            displaced = self.displaced_blocks(fault)
+            if displaced:
+                error += "; final check: " + "; ".join(d.describe() for d in displaced)
             fault_tower = moves[mv].from_tower  # where the block was (missing) or came from (dropped)
         else:
             mv = block = None
@@ -369,7 +438,7 @@ class _Run:
             moves_total=len(moves), final_blocks=tuple(final), suction_on_at_end=cup.on, at_home_at_end=at_home,
             sim_time_s=float(self.d.time), wall_time_s=wall, max_tracking_error_rad=self.max_err,
             feedback_events=tuple(self.events), fault_move=mv, fault_block=block, fault_tower=fault_tower,
-            detection_latency_s=latency, warnings=warning_counts(self.d),
+            detection_latency_s=latency, displaced_blocks=tuple(displaced), warnings=warning_counts(self.d),
             feedback_trace=np.array(self.trace, dtype=float).reshape(-1, 3),
             joint_trace=self.joint_trace(settle_start),
         )
@@ -426,5 +495,5 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
 
     result = run.result(fault, wall, settle_start)
     if fault is not None:
-        raise SuctionFaultError(fault.message, result)
+        raise SuctionFaultError(result.error or fault.message, result)
     return result

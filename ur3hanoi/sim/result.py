@@ -51,6 +51,29 @@ class FinalBlock:
 
 
 @dataclass(frozen=True)
+class DisplacedBlock:
+    """A block knocked out of place after a halt: it rested at ``tower``/``height`` (0-based; None: in no slot)
+    when the fault was detected and has since moved ``moved_m`` [m] (e.g. hit by the dropped block)."""
+
+    block: int
+    tower: int | None
+    height: int | None
+    moved_m: float
+
+    def describe(self) -> str:
+        where = "" if self.tower is None or self.height is None else \
+            f" at tower {self.tower + 1} height {self.height + 1}"
+        return (f"{block_colour(self.block)} block {self.block + 1} was knocked {self.moved_m * 1e3:.1f} mm out of "
+                f"its place{where}")
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"block": self.block + 1, "colour": block_colour(self.block),
+                "tower": None if self.tower is None else self.tower + 1,
+                "height": None if self.height is None else self.height + 1,
+                "moved_mm": round(self.moved_m * 1e3, 3)}
+
+
+@dataclass(frozen=True)
 class JointTrace:
     """The joint reference the executor streamed and the simulated arm joints, one row per control cycle.
 
@@ -106,6 +129,8 @@ class SimResult:
     fault_block: int | None = None
     fault_tower: int | None = None
     detection_latency_s: float | None = None
+    # Blocks knocked out of place after a halt (the final verification of a halted run).
+    displaced_blocks: tuple[DisplacedBlock, ...] = ()
     warnings: dict[str, int] = field(default_factory=dict)
     # gripper_input every control cycle: columns t [s], DIGIN, AIN0 [V] (for plots; not in the JSON).
     feedback_trace: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
@@ -136,6 +161,7 @@ class SimResult:
                 "block": None if self.fault_block is None else self.fault_block + 1,
                 "tower": None if self.fault_tower is None else self.fault_tower + 1,
                 "detection_latency_s": self.detection_latency_s,
+                "displaced_blocks": [b.as_dict() for b in self.displaced_blocks],
             },
             "mujoco_warnings": self.warnings,
             "feedback_events": [e.as_dict() for e in self.feedback_events],
