@@ -9,6 +9,7 @@ export MUJOCO_GL ?= egl
 .PHONY: solve test venv lint bench tables docs clean
 
 $(STAMP): pyproject.toml requirements.lock
+	@$(PY) -c 'import sys; ok = (3, 11) <= sys.version_info[:2] <= (3, 13); ok or print(f"ur3hanoi: error: Python {sys.version.split()[0]} ($(PY)) is not supported: use Python 3.11, 3.12 or 3.13, e.g. make PY=python3.12"); sys.exit(not ok)'
 	bash tools/ensure-system-deps.sh
 	$(PY) -m venv $(VENV)
 	$(VENV)/bin/pip install -q --upgrade pip
