@@ -14,7 +14,7 @@ from ur3hanoi.hanoi import solve_hanoi
 from ur3hanoi.plan import Phase, Plan, PlanConfig, Trajectory, plan_solve
 from ur3hanoi.robot import N_JOINTS
 from ur3hanoi.station import Station, load_station
-from ur3hanoi.table import generate_table
+from ur3hanoi.waypoints import generate_table
 
 STATIONS = {name: load_station(name) for name in ("lab_sim", "lab_real")}
 PAIRS = list(itertools.permutations(range(3), 2))

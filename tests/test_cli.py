@@ -1,7 +1,9 @@
-"""The `ur3hanoi` command: exit codes, one-line errors, and the guarantee that failures write nothing."""
+"""The `ur3hanoi` command: exit codes, one-line errors, option ranges, refused outputs, no traceback ever."""
 
 from __future__ import annotations
 
+import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -10,8 +12,13 @@ import pytest
 import yaml
 
 from ur3hanoi.cli import main
+from ur3hanoi.cli.exit_codes import EXIT_CODES, exit_code_for
+from ur3hanoi.cli.options import DWELL, RATE, SEED, SPEED, option
+from ur3hanoi.errors import PlanError, SuctionFaultError, Ur3HanoiError
 
 from .conftest import LAB_REAL, LAB_SIM, REPO
+
+LAB_TABLE = REPO / "tables/lab2_data.yaml"
 
 
 def _bad_calibration(tmp_path: Path, **grid: object) -> Path:
@@ -20,6 +27,15 @@ def _bad_calibration(tmp_path: Path, **grid: object) -> Path:
     path = tmp_path / "bad_station.yaml"
     path.write_text(yaml.safe_dump(raw))
     return path
+
+
+def _one_error_line(err: str) -> str:
+    assert err.count("\n") == 1 and err.endswith("\n"), err
+    assert "Traceback" not in err
+    return err
+
+
+# ------------------------------------------------------------------------------------------------- tables
 
 
 def test_tables_writes_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -35,8 +51,7 @@ def test_unreachable_grid_exits_2_with_one_line_and_writes_nothing(tmp_path: Pat
                                                     [0.95, 0.04, 0.0288]])
     out = tmp_path / "lab2_data.yaml"
     assert main(["tables", str(cal), "--key", "real_pos", "-o", str(out)]) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1
+    err = _one_error_line(capsys.readouterr().err)
     assert "tower 2 height 0 on" in err and "unreachable" in err and "target xyz" in err and "residual" in err
     assert not out.exists()
 
@@ -57,28 +72,48 @@ def test_invalid_calibration_exits_2(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert "bad_station.yaml: field 'grid.heights' = 0 is invalid: expected an integer in [1, 20]" in err
 
 
+def test_typo_in_calibration_is_refused_by_tables(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cal = tmp_path / "typo.yaml"
+    cal.write_text(LAB_SIM.read_text().replace("base_rpy_deg: [0, 0, 0]", "base_rpy: [0, 0, 90]"))
+    out = tmp_path / "lab2_data.yaml"
+    assert main(["tables", str(cal), "--key", "sim_pos", "-o", str(out)]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert "field 'robot.base_rpy' is unknown: did you mean 'robot.base_rpy_deg'?" in err
+    assert not out.exists()
+
+
 def test_missing_calibration_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["tables", str(tmp_path / "nope.yaml"), "--key", "sim_pos", "-o", str(tmp_path / "o.yaml")]) == 2
     assert "nope.yaml" in capsys.readouterr().err
 
 
-def test_bad_key_is_an_argparse_error(tmp_path: Path) -> None:
-    with pytest.raises(SystemExit) as info:
-        main(["tables", str(LAB_SIM), "--key", "gazebo", "-o", str(tmp_path / "o.yaml")])
-    assert info.value.code == 2
+def test_bad_key_is_a_one_line_usage_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["tables", str(LAB_SIM), "--key", "gazebo", "-o", str(tmp_path / "o.yaml")]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert err.startswith("ur3hanoi tables: error: argument --key: invalid choice: 'gazebo'")
+    assert err.rstrip().endswith("(see ur3hanoi tables --help)")
 
 
-def test_check_table_ok_and_fail(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    table = REPO / "tables/lab2_data.yaml"
-    assert main(["check-table", str(table), "--key", "real_pos", "--calibration", str(LAB_REAL)]) == 0
+def test_help_and_version_return_0(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.startswith("ur3hanoi ")
+    assert main(["tables", "--help"]) == 0
+    assert "a symlink is written through to its target" in " ".join(capsys.readouterr().out.split())
+
+
+# ------------------------------------------------------------------------------------------------ check-table
+
+
+def test_check_table_ok_and_fail(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["check-table", str(LAB_TABLE), "--key", "real_pos", "--calibration", str(LAB_REAL)]) == 0
     assert "18/18 entries within 1.0 mm / 0.5 deg" in capsys.readouterr().out
     # The same joints judged against another station's grid are far off: exit 1.
-    assert main(["check-table", str(table), "--key", "real_pos", "--calibration", str(LAB_SIM)]) == 1
+    assert main(["check-table", str(LAB_TABLE), "--key", "real_pos", "--calibration", str(LAB_SIM)]) == 1
     assert "0/18 entries" in capsys.readouterr().out
 
 
 def test_check_table_on_hand_recorded_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    data = yaml.safe_load((REPO / "tables/lab2_data.yaml").read_text())
+    data = yaml.safe_load(LAB_TABLE.read_text())
     q = data["real_pos"]
     q[0][1][1][0] += 0.002  # a 2 mrad pan error on one recorded entry
     hand = tmp_path / "hand.yaml"
@@ -91,10 +126,198 @@ def test_check_table_on_hand_recorded_file(tmp_path: Path, capsys: pytest.Captur
     assert "17/18 entries within 0.1 mm" in capsys.readouterr().out
 
 
-def test_check_table_missing_key_exits_2(capsys: pytest.CaptureFixture[str]) -> None:
-    table = REPO / "tables/lab2_data.yaml"
-    assert main(["check-table", str(table), "--key", "gazebo_pos", "--calibration", str(LAB_REAL)]) == 2
-    assert "key 'gazebo_pos' not found" in capsys.readouterr().err
+def test_check_table_missing_key_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    only_sim = tmp_path / "sim.yaml"
+    assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(only_sim)]) == 0
+    capsys.readouterr()
+    assert main(["check-table", str(only_sim), "--key", "real_pos", "--calibration", str(LAB_REAL)]) == 2
+    assert "key 'real_pos' not found (table keys present: sim_pos)" in _one_error_line(capsys.readouterr().err)
+
+
+# ---------------------------------------------------------------------------------------------------- options
+
+SPEED_RANGE = "a fraction of the joint speed, acceleration and jerk limits in [0.01, 1]"
+BAD_OPTIONS = [
+    (["plan", "--start", "1", "--end", "3", "--rate", "1e-9"], "--rate", "a sample rate [Hz] in [1, 10000]"),
+    (["plan", "--start", "1", "--end", "3", "--rate", "1e9"], "--rate", "a sample rate [Hz] in [1, 10000]"),
+    (["plan", "--start", "1", "--end", "3", "--rate", "nan"], "--rate", "a sample rate [Hz] in [1, 10000]"),
+    (["plan", "--start", "1", "--end", "3", "--speed", "1e-12"], "--speed", SPEED_RANGE),
+    (["plan", "--start", "1", "--end", "3", "--speed", "1.5"], "--speed", SPEED_RANGE),
+    (["plan", "--start", "1", "--end", "3", "--dwell", "1e300"], "--dwell", "a dwell time [s] in [0, 10]"),
+    (["plan", "--start", "1", "--end", "3", "--dwell", "-0.1"], "--dwell", "a dwell time [s] in [0, 10]"),
+    (["plan", "--start", "0", "--end", "3"], "--start", "a tower number (1-based) in [1, 10]"),
+    (["plan", "--start", "1", "--end", "3", "--blocks", "11"], "--blocks", "a number of blocks in [1, 10]"),
+    (["plan", "--start", "1", "--end", "3", "--blocks", "2.5"], "--blocks", "a number of blocks in [1, 10]"),
+    (["solve", "--start", "1", "--end", "3", "--seed", "-1"], "--seed", "a seed in [0, 4294967295]"),
+    (["solve", "--start", "1", "--end", "3", "--seed", str(2**32)], "--seed", "a seed in [0, 4294967295]"),
+    (["solve", "--start", "1", "--end", "3", "--seed", "9" * 5000], "--seed", "a seed in [0, 4294967295]"),
+    (["solve", "--start", "1", "--end", "3", "--speed", "0"], "--speed", SPEED_RANGE),
+    (["solve", "--start", "1", "--end", "3", "--remove-block", "0"], "--remove-block", "a height (1-based)"),
+    (["solve", "--start", "1", "--end", "3", "--drop-during-move", "1e3"], "--drop-during-move", "a move number"),
+    (["check-table", str(LAB_TABLE), "--key", "real_pos", "--calibration", "lab_real", "--tol-mm", "0"],
+     "--tol-mm", "a position tolerance [mm] in (0, 1000]"),
+    (["check-table", str(LAB_TABLE), "--key", "real_pos", "--calibration", "lab_real", "--tol-deg", "inf"],
+     "--tol-deg", "an orientation tolerance [deg] in (0, 180]"),
+]
+
+
+@pytest.mark.parametrize(("argv", "flag", "expected"), BAD_OPTIONS, ids=[" ".join(a[-2:])[:30] for a, _, _ in
+                                                                            BAD_OPTIONS])
+def test_every_numeric_option_is_range_checked(argv: list[str], flag: str, expected: str,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(argv) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert f"error: argument {flag}: " in err and f"is invalid: expected {expected}" in err
+    assert len(err) < 300
+
+
+@pytest.mark.parametrize(("spec", "ok", "bad"), [(SPEED, ["0.01", "1"], ["0.0099", "1.0001"]),
+                                                  (RATE, ["1", "10000"], ["0.999", "10000.1"]),
+                                                  (DWELL, ["0", "10"], ["-1e-9", "10.001"]),
+                                                  (SEED, ["0", str(2**32 - 1)], [str(2**32), "1.0"])])
+def test_option_range_boundaries(spec: object, ok: list[str], bad: list[str]) -> None:
+    import argparse
+
+    parse = option(spec)  # type: ignore[arg-type]
+    for text in ok:
+        assert parse(text) == float(text)
+    for text in bad:
+        with pytest.raises(argparse.ArgumentTypeError):
+            parse(text)
+
+
+def test_plan_too_large_is_refused_before_planning(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["plan", "--start", "1", "--end", "3", "--calibration", "lab_real", "--rate", "10000", "--speed", "0.01"]
+    assert main(argv) == 2
+    assert "more than 5000000: use fewer blocks" in _one_error_line(capsys.readouterr().err)
+
+
+def test_blocks_beyond_the_grid_is_a_puzzle_error(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["plan", "--start", "1", "--end", "3", "--blocks", "4"]) == 2
+    assert "4 blocks is invalid: expected 1..3" in _one_error_line(capsys.readouterr().err)
+
+
+# ---------------------------------------------------------------------------------------------------- outputs
+
+
+def test_output_that_is_the_input_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cal = tmp_path / "X.yaml"
+    shutil.copy(LAB_REAL, cal)
+    before = cal.read_bytes()
+    assert main(["tables", str(cal), "--key", "real_pos", "-o", str(cal)]) == 2
+    assert "it is also an input of this command" in _one_error_line(capsys.readouterr().err)
+    assert cal.read_bytes() == before
+    link = tmp_path / "link.yaml"
+    link.symlink_to(cal)  # the same file under another name
+    assert main(["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos", "--base", str(cal),
+                 "-o", str(link)]) == 2
+    assert cal.read_bytes() == before
+    assert main(["plan", "--start", "1", "--end", "3", "--calibration", str(cal), "--csv", str(cal)]) == 2
+    assert cal.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["X.yaml", "link.yaml"]
+
+
+@pytest.mark.parametrize("kind", ["directory", "fifo", "device", "missing-dir", "empty"])
+def test_unwritable_outputs_are_refused_in_one_line(kind: str, tmp_path: Path,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    out = {"directory": str(tmp_path), "fifo": str(tmp_path / "fifo"), "device": "/dev/null",
+           "missing-dir": str(tmp_path / "no" / "t.yaml"), "empty": ""}[kind]
+    if kind == "fifo":
+        os.mkfifo(out)
+    assert main(["tables", "lab_real", "--key", "real_pos", "-o", out]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert err.startswith("ur3hanoi: error: cannot write ")
+    expected = {"directory": "it is a directory", "fifo": "it is a FIFO", "device": "it is a device",
+                "missing-dir": "does not exist", "empty": "the path is empty"}[kind]
+    assert expected in err
+    assert [p.name for p in tmp_path.iterdir()] == (["fifo"] if kind == "fifo" else [])
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only directories")
+def test_read_only_directory_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    try:
+        assert main(["tables", "lab_real", "--key", "real_pos", "-o", str(ro / "t.yaml")]) == 2
+        assert "is not writable" in _one_error_line(capsys.readouterr().err)
+    finally:
+        ro.chmod(0o755)
+
+
+def test_paths_with_control_characters_keep_the_header_a_comment(tmp_path: Path,
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    cal = tmp_path / "cal\nsim_pos: 1\x1b[31m.yaml"
+    shutil.copy(LAB_REAL, cal)
+    out = tmp_path / "out\n.yaml"
+    assert main(["tables", str(cal), "--key", "real_pos", "-o", str(out)]) == 0
+    stdout = capsys.readouterr().out
+    assert stdout.count("\n") == 1 and "\x1b" not in stdout
+    assert main(["check-table", str(out), "--key", "real_pos", "--calibration", str(cal)]) == 0
+    lines = out.read_text().splitlines()
+    assert all(line.startswith(("#", "real_pos:", "- ", "  ")) for line in lines)
+    station = tmp_path / "fitted\r\n\u2028.yaml"
+    assert main(["calibrate", "--from-table", str(out), "--key", "real_pos", "--base", str(cal), "-o",
+                 str(station)]) == 0
+    header = [line for line in station.read_text().splitlines() if line.startswith("# ")]
+    assert len(header) == 4 and "cal\\nsim_pos: 1\\x1b[31m.yaml" in header[2]
+    assert main(["check-table", str(out), "--key", "real_pos", "--calibration", str(station)]) == 0
+
+
+# ------------------------------------------------------------------------------------------- error mapping
+
+
+def test_library_errors_map_to_exit_codes() -> None:
+    assert exit_code_for(SuctionFaultError("halted")) == 3
+    assert exit_code_for(PlanError("x")) == 2
+    assert exit_code_for(Ur3HanoiError("x")) == 2
+    assert [code for _, code in EXIT_CODES] == [3, 2]
+
+
+def _raise(exc: BaseException) -> object:
+    def boom(*args: object, **kwargs: object) -> object:
+        raise exc
+
+    return boom
+
+
+def test_suction_fault_exits_3(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+                               capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr("ur3hanoi.waypoints.generate_table", _raise(SuctionFaultError("block 2 is not held")))
+    assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(tmp_path / "t.yaml")]) == 3
+    assert _one_error_line(capsys.readouterr().err) == "ur3hanoi: error: block 2 is not held\n"
+
+
+def test_unexpected_exception_is_one_line_exit_70(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr("ur3hanoi.waypoints.generate_table", _raise(ZeroDivisionError("float division\nby zero")))
+    argv = ["tables", "lab_sim", "--key", "sim_pos", "-o", str(tmp_path / "t.yaml")]
+    assert main(argv) == 70
+    err = _one_error_line(capsys.readouterr().err)
+    assert err == ("ur3hanoi tables: internal error: ZeroDivisionError: float division by zero (a bug: rerun with "
+                   "--debug for the traceback)\n")
+    with pytest.raises(ZeroDivisionError):
+        main(["--debug", *argv])
+    with pytest.raises(ZeroDivisionError):
+        main([*argv, "--debug"])
+    assert not (tmp_path / "t.yaml").exists()
+
+
+def test_keyboard_interrupt_exits_130(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+                                      capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr("ur3hanoi.waypoints.generate_table", _raise(KeyboardInterrupt()))
+    assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(tmp_path / "t.yaml")]) == 130
+    assert capsys.readouterr().err == "ur3hanoi tables: interrupted\n"
+
+
+def test_fifo_input_does_not_hang(tmp_path: Path) -> None:
+    fifo = tmp_path / "cal.yaml"
+    os.mkfifo(fifo)
+    res = subprocess.run([sys.executable, "-m", "ur3hanoi.cli", "tables", str(fifo), "--key", "sim_pos", "-o",
+                          str(tmp_path / "o.yaml")], capture_output=True, text=True, timeout=60)
+    assert res.returncode == 2
+    assert res.stderr == f"ur3hanoi: error: {fifo}: is a FIFO (named pipe), not a calibration file (expected a " \
+                         "regular file)\n"
 
 
 def test_console_script_entry_point() -> None:
@@ -111,3 +334,18 @@ def test_readme_cli_reference_is_up_to_date() -> None:
         sys.path.pop(0)
     readme = (REPO / "README.md").read_text()
     assert render(readme) == readme, "README CLI reference is stale: run `make docs`"
+
+
+def test_solve_render_outputs_are_checked_before_simulating(tmp_path: Path,
+                                                             capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["solve", "--start", "1", "--end", "3", "--video", str(tmp_path)]) == 2
+    assert "it is a directory" in _one_error_line(capsys.readouterr().err)
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert main(["solve", "--start", "1", "--end", "3", "--frames", str(blocker / "frames")]) == 2
+    assert "cannot write frames into" in _one_error_line(capsys.readouterr().err)
+    assert _listing(tmp_path) == ["file"]
+
+
+def _listing(directory: Path) -> list[str]:
+    return sorted(p.name for p in directory.iterdir())

@@ -128,7 +128,7 @@ def test_every_table_pose_both_solvers(shipped_station: Station) -> None:
 
 
 def test_branch_control_on_shipped_stations(shipped_station: Station) -> None:
-    from ur3hanoi.table import generate_table
+    from ur3hanoi.waypoints import generate_table
 
     table = generate_table(shipped_station)
     q_home = shipped_station.q_home_array

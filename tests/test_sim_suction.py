@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from ur3hanoi.sim import SuctionConfig, SuctionCup, TaskScene, build_task_scene
-from ur3hanoi.table import generate_table
+from ur3hanoi.waypoints import generate_table
 
 from .sim_helpers import STATIONS
 

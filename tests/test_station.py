@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 import yaml
 
@@ -139,15 +140,87 @@ def test_radians_form_is_accepted() -> None:
 
 
 def test_file_errors(tmp_path: Path) -> None:
-    with pytest.raises(CalibrationError, match="readable calibration file"):
+    with pytest.raises(CalibrationError, match=r"missing.yaml: cannot read the calibration file \(No such file or "
+                                               r"directory\); shipped stations: lab_real, lab_sim"):
         load_station(tmp_path / "missing.yaml")
     bad = tmp_path / "bad.yaml"
     bad.write_text("grid: [unclosed\n")
-    with pytest.raises(CalibrationError, match="valid YAML"):
+    with pytest.raises(CalibrationError, match=r"bad.yaml: not valid YAML: .*\(line 2, column 1\)"):
         load_station(bad)
     bad.write_text("- 1\n- 2\n")
-    with pytest.raises(CalibrationError, match="mapping"):
+    with pytest.raises(CalibrationError, match=r"expected a mapping with keys name, layout, robot, .*, got a list"):
         load_station(bad)
+    bad.write_text("")
+    with pytest.raises(CalibrationError, match="got an empty document"):
+        load_station(bad)
+
+
+def _dump(raw: dict[str, Any]) -> str:
+    return yaml.safe_dump(raw, sort_keys=False)
+
+
+def test_typo_base_rpy_is_an_error_with_the_suggestion(tmp_path: Path) -> None:
+    # The typo that silently produced an unrotated table: `base_rpy` instead of `base_rpy_deg`.
+    raw = _raw(LAB_SIM)
+    del raw["robot"]["base_rpy_deg"]
+    raw["robot"]["base_rpy"] = [0, 0, 10]
+    path = tmp_path / "typo.yaml"
+    path.write_text(_dump(raw))
+    with pytest.raises(CalibrationError) as info:
+        load_station(path)
+    assert str(info.value) == (f"{path}: field 'robot.base_rpy' is unknown: did you mean 'robot.base_rpy_deg'?")
+    # Spelled right, the rotation is used: the station's base pose differs from the unrotated one.
+    raw["robot"]["base_rpy_deg"] = raw["robot"].pop("base_rpy")
+    rotated = parse_station(raw, "ok.yaml")
+    assert rotated.base_rpy[2] == pytest.approx(math.radians(10))
+    assert not np.allclose(rotated.T_world_base.rotation, load_station(LAB_SIM).T_world_base.rotation)
+
+
+@pytest.mark.parametrize(
+    ("dotted", "value", "message"),
+    [
+        ("grids", {}, "field 'grids' is unknown: did you mean 'grid'?"),
+        ("colour", "red", "field 'colour' is unknown: expected one of name, layout, robot, tool, blocks, grid"),
+        ("tool.yaw", 90, "field 'tool.yaw' is unknown: did you mean 'tool.yaw_deg'?"),
+        ("grid.tower_orgins", [[0, 0, 0]] * 3, "field 'grid.tower_orgins' is unknown: did you mean "
+                                               "'grid.tower_origins'?"),
+        ("robot.home", [0] * 6, "field 'robot.home' is unknown: did you mean 'robot.home_deg'?"),
+    ],
+)
+def test_unknown_keys_are_errors_naming_the_nearest_valid_one(dotted: str, value: Any, message: str) -> None:
+    raw = _mutated(LAB_SIM, dotted, value)
+    with pytest.raises(CalibrationError) as info:
+        parse_station(raw, "bad.yaml")
+    assert str(info.value) == f"bad.yaml: {message}"
+
+
+def test_duplicate_key_is_an_error(tmp_path: Path) -> None:
+    text = LAB_SIM.read_text()
+    path = tmp_path / "dup.yaml"
+    path.write_text(text.replace("  approach: 0.096", "  approach: 0.096\n  'approach': 0.05"))
+    with pytest.raises(CalibrationError, match=r"dup.yaml: not valid YAML: duplicate key 'approach' \(first given "
+                                               r"on line \d+\) \(line \d+, column 3\)"):
+        load_station(path)
+
+
+@pytest.mark.parametrize(
+    ("dotted", "value", "match"),
+    [
+        ("grid.towers", "3", r"field 'grid.towers' = '3' is invalid: expected an integer in \[2, 10\]"),
+        ("blocks.size", True, r"field 'blocks.size' = True is invalid: expected a length \[m\] in \(0, 0.2\]"),
+        ("grid.approach", 10**400, r"field 'grid.approach' = 1000.*000 is invalid: expected a length"),
+        ("grid.heights", 10**400, r"field 'grid.heights' = 1000.*000 is invalid: expected an integer in \[1, 20\]"),
+        ("robot.base_xyz", [0, float("-inf"), 0], r"field 'robot.base_xyz\[1\]' = -inf is invalid"),
+        ("name", "two\nlines", r"field 'name' = 'two\\nlines' is invalid: expected a non-empty single-line"),
+        ("name", "x" * 5000, r"field 'name' = 'x{20,40}\.\.\.x{20,40}' is invalid"),
+        ("layout", ["flat"] * 10000, r"field 'layout' = \['flat', 'flat', .*\.\.\.\] is invalid"),
+    ],
+    ids=["string-int", "bool", "huge-float", "huge-int", "inf", "newline-name", "long-name", "long-list"],
+)
+def test_wrong_types_and_huge_values_name_file_field_value_and_range(dotted: str, value: Any, match: str) -> None:
+    with pytest.raises(CalibrationError, match=match) as info:
+        parse_station(_mutated(LAB_SIM, dotted, value), "bad.yaml")
+    assert len(str(info.value)) < 250 and "\n" not in str(info.value)
 
 
 def test_stations_are_frozen(lab_sim: Station) -> None:

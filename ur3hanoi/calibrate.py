@@ -9,15 +9,7 @@ or, from an existing (e.g. hand-recorded) lab-format table, every entry ``Q[t][h
 
     ur3hanoi calibrate --from-table lab2_data.yaml --key real_pos --base lab_real -o out.yaml
 
-Taught-points file (tower and height are 0-based, like ``Q[tower][height]`` of ``lab2_data.yaml``)::
-
-    units: deg            # deg | rad (required: a pose in the wrong unit is caught, see below)
-    points:               # contact ("on") poses unless `pose: above`
-      - {tower: 0, height: 0, q: [..6 joint values..]}
-      - {tower: 1, height: 0, q: [...]}
-      - {tower: 2, height: 0, q: [...]}
-      - {tower: 0, height: 2, q: [...]}                # optional extra points
-      - {tower: 1, height: 0, pose: above, q: [...]}
+The taught-points file and its checks are :mod:`ur3hanoi.taught`.
 
 What is fitted, and how. Each pose's suction point (TCP) is computed by forward kinematics, in the station's world
 frame (``T_world_base * fk(q, "tcp")``, with the base calibration's robot base and tool offset). The grid model is
@@ -54,168 +46,32 @@ outside the base calibration's grid, a tower with no taught point, a pose whose 
 
 from __future__ import annotations
 
-import hashlib
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import yaml
 
 from ur3hanoi import __version__
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.errors import CalibrationError, TaughtPointsError
-from ur3hanoi.grid import ABOVE, ON, POSE_NAMES, T_world_tcp
+from ur3hanoi.errors import CalibrationError, TaughtPointsError, printable
+from ur3hanoi.grid import ABOVE, POSE_NAMES, T_world_tcp
 from ur3hanoi.ik import wrap_angle
-from ur3hanoi.robot import N_JOINTS, load_ur3
+from ur3hanoi.io.atomic import atomic_write
+from ur3hanoi.io.yaml_loader import parse_yaml
+from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import Station, parse_station, station_to_dict
-from ur3hanoi.table import atomic_write, read_table
+from ur3hanoi.taught import TaughtPoint, TaughtPoints
 
-UNITS: tuple[str, ...] = ("deg", "rad")
 RESIDUAL_WARN_MM = 2.0  # [mm] a point farther than this from the fitted grid is probably mis-recorded
 MAX_TILT_DEG = 10.0  # [deg] a taught pose's tool must point down within this (the table uses exactly down)
 YAW_WARN_DEG = 2.0  # [deg] a heading this far from the mean suggests a mis-recorded wrist 3
-_POINT_KEYS = frozenset({"tower", "height", "pose", "q"})
-_TWO_PI = 2 * math.pi
-
-
-# --------------------------------------------------------------------------------------------- taught points
-
-
-@dataclass(frozen=True)
-class TaughtPoint:
-    """One taught pose.
-
-    Attributes:
-        index: position in the taught list (``points[index]``; table entries are numbered in Q order).
-        tower, height: grid slot, 0-based.
-        k: 0 = contact ("on") pose, 1 = the pose above it.
-        q: joint angles [rad], controller convention.
-    """
-
-    index: int
-    tower: int
-    height: int
-    k: int
-    q: tuple[float, ...]
-
-    @property
-    def label(self) -> str:
-        return f"points[{self.index}] (tower {self.tower} height {self.height} {POSE_NAMES[self.k]})"
-
-
-@dataclass(frozen=True)
-class TaughtPoints:
-    """The taught poses of one file, with provenance for the output's header."""
-
-    points: tuple[TaughtPoint, ...]
-    source: str
-    sha256: str
 
 
 def _fail(source: str, msg: str) -> TaughtPointsError:
-    return TaughtPointsError(f"{source}: {msg}")
-
-
-def _int_field(source: str, where: str, item: Mapping[str, Any], key: str) -> int:
-    v = item.get(key)
-    if isinstance(v, bool) or not isinstance(v, int):
-        raise _fail(source, f"{where}: '{key}' = {v!r} is invalid: expected a 0-based integer index")
-    return int(v)
-
-
-def _check_units(source: str, raw: Sequence[Sequence[float]], units: str, labels: Sequence[str]) -> None:
-    """Catch the classic mix-up: degrees written under ``units: rad`` or radians under ``units: deg``."""
-    if not raw:
-        return
-    if units == "rad":
-        for vals, label in zip(raw, labels, strict=True):
-            worst = max(abs(v) for v in vals)
-            if worst > _TWO_PI + 1e-9:
-                raise _fail(source, f"{label}: joint value {worst:g} is outside +-2pi with units rad: "
-                                    "looks like degrees (set 'units: deg')")
-    else:
-        # A down-pointing pose always has some joint far beyond 2pi degrees (6.3 deg): all of them that small
-        # means the numbers are radians.
-        worst = max(abs(v) for vals in raw for v in vals)
-        if worst <= _TWO_PI:
-            raise _fail(source, f"every joint value is within +-2pi (largest {worst:g}) with units deg: "
-                                "looks like radians (set 'units: rad')")
-
-
-def parse_taught(data: Any, source: str = "<memory>", sha256: str = "") -> TaughtPoints:
-    """Validate a parsed taught-points document (see the module docstring) and convert it to radians.
-
-    Raises:
-        TaughtPointsError: bad structure, unknown units, wrong joint count, or values in the other unit.
-    """
-    if not isinstance(data, Mapping):
-        raise _fail(source, f"expected a YAML mapping with 'units' and 'points', got {type(data).__name__}")
-    units = data.get("units")
-    if units not in UNITS:
-        raise _fail(source, f"'units' = {units!r} is invalid: expected one of {UNITS}")
-    items = data.get("points")
-    if not isinstance(items, list) or not items:
-        raise _fail(source, f"'points' = {items!r:.60} is invalid: expected a non-empty list of "
-                            "{tower, height, q[, pose]} entries")
-    unknown_top = sorted(set(data) - {"units", "points"}, key=str)
-    if unknown_top:
-        raise _fail(source, f"unknown top-level key(s) {unknown_top}: expected 'units' and 'points'")
-    raw: list[TaughtPoint] = []  # q still in `units`
-    for i, item in enumerate(items):
-        where = f"points[{i}]"
-        if not isinstance(item, Mapping):
-            raise _fail(source, f"{where} = {item!r:.60} is invalid: expected a mapping {{tower, height, q}}")
-        extra = sorted(set(item) - _POINT_KEYS, key=str)
-        if extra:
-            raise _fail(source, f"{where}: unknown key(s) {extra}: expected {sorted(_POINT_KEYS)}")
-        tower = _int_field(source, where, item, "tower")
-        height = _int_field(source, where, item, "height")
-        pose = item.get("pose", "on")
-        if pose not in POSE_NAMES:
-            raise _fail(source, f"{where}: 'pose' = {pose!r} is invalid: expected one of {POSE_NAMES}")
-        q = item.get("q")
-        if not isinstance(q, list):
-            raise _fail(source, f"{where}: 'q' = {q!r:.60} is invalid: expected a list of {N_JOINTS} joint values")
-        if len(q) != N_JOINTS:
-            raise _fail(source, f"{where}: 'q' has {len(q)} joint values, expected {N_JOINTS}")
-        for j, v in enumerate(q):
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise _fail(source, f"{where}: q[{j}] = {v!r} is invalid: expected a finite number [{units}]")
-        raw.append(TaughtPoint(index=i, tower=tower, height=height, k=POSE_NAMES.index(pose),
-                               q=tuple(float(v) for v in q)))
-    _check_units(source, [p.q for p in raw], units, [p.label for p in raw])
-    scale = math.pi / 180.0 if units == "deg" else 1.0
-    points = tuple(replace(p, q=tuple(v * scale for v in p.q)) for p in raw)
-    return TaughtPoints(points=points, source=source, sha256=sha256)
-
-
-def load_taught(path: str | Path) -> TaughtPoints:
-    """Read a taught-points YAML file (see the module docstring). Raises TaughtPointsError naming the file."""
-    p = Path(path)
-    source = str(path)
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise _fail(source, f"cannot read taught-points file ({exc.strerror})") from None
-    try:
-        data = yaml.safe_load(raw)
-    except yaml.YAMLError as exc:
-        raise _fail(source, f"not valid YAML ({str(exc).splitlines()[0]})") from None
-    return parse_taught(data, source, hashlib.sha256(raw).hexdigest())
-
-
-def taught_from_table(path: str | Path, key: str) -> TaughtPoints:
-    """Every entry ``Q[t][h][k]`` [rad] of a lab-format table as a taught point (numbered in Q order)."""
-    q = read_table(path, key)
-    source = f"{path}:{key}"
-    slots = [(t, h, k) for t in range(q.shape[0]) for h in range(q.shape[1]) for k in (ON, ABOVE)]
-    points = tuple(TaughtPoint(index=i, tower=t, height=h, k=k, q=tuple(float(v) for v in q[t, h, k]))
-                   for i, (t, h, k) in enumerate(slots))
-    _check_units(source, [p.q for p in points], "rad", [f"{source}[{t}][{h}][{k}]" for t, h, k in slots])
-    return TaughtPoints(points=points, source=source, sha256=hashlib.sha256(Path(path).read_bytes()).hexdigest())
+    return TaughtPointsError(f"{printable(source)}: {msg}", source=source)
 
 
 # ------------------------------------------------------------------------------------------------------ fitting
@@ -460,8 +316,8 @@ def calibration_text(fit: CalibrationFit, taught: TaughtPoints, base: Station, t
     worst = int(np.argmax(fit.residuals_mm))
     head = [
         f"# Generated by ur3hanoi {__version__} calibrate: grid fitted to taught poses by least squares.",
-        f"# taught: {taught_label or taught.source} (sha256 {taught.sha256 or 'n/a'})",
-        f"# base:   {base_label or base.source} (sha256 {base.sha256 or 'n/a'})",
+        f"# taught: {printable(taught_label or taught.source, 4096)} (sha256 {taught.sha256 or 'n/a'})",
+        f"# base:   {printable(base_label or base.source, 4096)} (sha256 {base.sha256 or 'n/a'})",
         f"# fitted: {', '.join(fit.fitted_params)}; {len(fit.points)} points, redundancy {fit.dof}, "
         f"residual rms {fit.rms_mm:.3f} mm, max {fit.max_mm:.3f} mm at {fit.points[worst].label}",
     ]
@@ -469,28 +325,29 @@ def calibration_text(fit: CalibrationFit, taught: TaughtPoints, base: Station, t
 
 
 def write_calibration(path: str | Path, fit: CalibrationFit, taught: TaughtPoints, base: Station,
-                      taught_label: str | None = None, base_label: str | None = None) -> str:
-    """Write the fitted station to ``path`` atomically after checking it loads back; returns the text."""
+                      taught_label: str | None = None, base_label: str | None = None,
+                      inputs: Sequence[str | Path] = ()) -> str:
+    """Write the fitted station to ``path`` atomically after checking it loads back; returns the text.
+
+    Raises:
+        CalibrationError: the fitted station would not load back (e.g. an invalid name).
+        OutputError: ``path`` cannot be written (one of ``inputs``, a directory, a device, no space...); nothing
+            was written.
+    """
     text = calibration_text(fit, taught, base, taught_label, base_label)
     # Never leave a file that `load_station` would reject.
-    parse_station(yaml.safe_load(text), str(path))
-    atomic_write(path, text)
+    parse_station(parse_yaml(text, str(path), what="calibration file", error=CalibrationError), str(path))
+    atomic_write(path, text, inputs=inputs)
     return text
 
 
 __all__ = [
     "MAX_TILT_DEG",
     "RESIDUAL_WARN_MM",
-    "UNITS",
     "YAW_WARN_DEG",
     "CalibrationFit",
     "ResidualRow",
-    "TaughtPoint",
-    "TaughtPoints",
     "calibration_text",
     "fit_station",
-    "load_taught",
-    "parse_taught",
-    "taught_from_table",
     "write_calibration",
 ]

@@ -32,7 +32,6 @@ Example (the course's flat Gazebo layout)::
 
 from __future__ import annotations
 
-import hashlib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -41,10 +40,12 @@ from typing import Any, Literal
 
 import numpy as np
 import pinocchio as pin
-import yaml
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.errors import CalibrationError
+from ur3hanoi.errors import MISSING, CalibrationError, printable
+from ur3hanoi.io.schema import Choice, Field, ListOf, Number, Record, Text, Vector
+from ur3hanoi.io.schema import validate as validate_schema
+from ur3hanoi.io.yaml_loader import load_yaml_file
 from ur3hanoi.resources import station_file, station_names
 from ur3hanoi.robot import FLANGE_FRAMES, N_JOINTS, JointLimits, ToolOffset
 
@@ -110,8 +111,8 @@ class Station:
 
     def with_grid(
         self,
-        tower_origins: Sequence[Sequence[float]],
-        height_step: Sequence[float],
+        tower_origins: Sequence[Sequence[float]] | FloatArray,
+        height_step: Sequence[float] | FloatArray,
         tool_yaw: float,
         approach: float | None = None,
         source: str = "<memory>",
@@ -130,159 +131,144 @@ class Station:
         return new
 
 
-def _vec3(v: Sequence[float]) -> Vec3:
+def _vec3(v: Sequence[float] | FloatArray) -> Vec3:
     a = [float(x) for x in v]
     return (a[0], a[1], a[2])
 
 
-# ---------------------------------------------------------------------------------------------- parsing helpers
+# ------------------------------------------------------------------------------------------------------ schema
+
+_M = "m"
+_LENGTH = Number(-10.0, 10.0, unit=_M, what="a length")
+_POINT = Vector(3, _LENGTH)
+_DEG = Number(-360.0, 360.0, unit="deg", what="an angle")
+_RAD = Number(-2 * math.pi, 2 * math.pi, unit="rad", what="an angle")
 
 
-class _Reader:
-    """Reads typed fields from the parsed YAML, raising CalibrationError that names file and field."""
+def _angles(prefix: str, n: int) -> dict[str, Field]:
+    """The ``<prefix>_deg`` / ``<prefix>_rad`` pair (exactly one of them is given; checked by the parser)."""
+    return {f"{prefix}_deg": Field(Vector(n, _DEG), required=False),
+            f"{prefix}_rad": Field(Vector(n, _RAD), required=False)}
 
-    def __init__(self, source: str, data: Mapping[str, Any]) -> None:
-        self.source = source
-        self.data = data
 
-    def fail(self, field: str, value: object, allowed: str) -> CalibrationError:
-        return CalibrationError(self.source, field, value, allowed)
+STATION_SCHEMA = Record({
+    "name": Field(Text(max_len=255), required=False),
+    "layout": Field(Choice(LAYOUTS)),
+    "robot": Field(Record({
+        "base_xyz": Field(_POINT),
+        **_angles("base_rpy", 3),
+        **_angles("home", N_JOINTS),
+        "elbow_limit_deg": Field(Number(0.0, 360.0, lo_open=True, unit="deg", what="an angle"), required=False),
+    })),
+    "tool": Field(Record({
+        "parent": Field(Choice(FLANGE_FRAMES)),
+        "xyz": Field(Vector(3, Number(-0.5, 0.5, unit=_M, what="a length"))),
+        **_angles("rpy", 3),
+        "yaw_deg": Field(_DEG),
+    })),
+    "blocks": Field(Record({
+        "size": Field(Number(0.0, 0.2, lo_open=True, unit=_M, what="a length")),
+        "contact_depth": Field(Number(0.0, 0.2, unit=_M, what="a length")),
+    })),
+    "grid": Field(Record({
+        "towers": Field(Number(2, MAX_TOWERS, integer=True)),
+        "heights": Field(Number(1, MAX_HEIGHTS, integer=True)),
+        "origin": Field(_POINT, required=False),
+        "tower_step": Field(_POINT, required=False),
+        "tower_origins": Field(ListOf(_POINT, 2, MAX_TOWERS, what="points [x, y, z]"), required=False),
+        "height_step": Field(_POINT),
+        "approach": Field(Number(0.0, 0.5, lo_open=True, unit=_M, what="a length")),
+    })),
+})
+"""The calibration file's schema: every key, its type and range (see ``ur3hanoi/stations/README.md``)."""
 
-    def get(self, path: str, required: bool = True, default: Any = None) -> Any:
-        node: Any = self.data
-        for part in path.split("."):
-            if not isinstance(node, Mapping) or part not in node:
-                if required:
-                    raise self.fail(path, "<missing>", "a value (the field is required)")
-                return default
-            node = node[part]
-        return node
 
-    def number(self, path: str, value: Any, lo: float = -math.inf, hi: float = math.inf,
-               lo_open: bool = False, what: str = "a number") -> float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.fail(path, value, what)
-        x = float(value)
-        if not math.isfinite(x):
-            raise self.fail(path, value, f"a finite {what}")
-        if x < lo or x > hi or (lo_open and x == lo):
-            lo_s = "(" if lo_open else "["
-            raise self.fail(path, value, f"{what} in {lo_s}{lo}, {hi}]")
-        return x
-
-    def vector(self, path: str, n: int, value: Any = None, unit: str = "", lo: float = -math.inf,
-               hi: float = math.inf) -> tuple[float, ...]:
-        value = self.get(path) if value is None else value
-        if not isinstance(value, list | tuple) or len(value) != n:
-            raise self.fail(path, value, f"a list of {n} numbers{unit}")
-        return tuple(self.number(f"{path}[{i}]", v, lo, hi, what=f"a number{unit}") for i, v in enumerate(value))
-
-    def integer(self, path: str, lo: int, hi: int) -> int:
-        value = self.get(path)
-        if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
-            raise self.fail(path, value, f"an integer in [{lo}, {hi}]")
-        return int(value)
-
-    def angles(self, base: str, n: int, required: bool = True, lo_deg: float = -math.inf,
-               hi_deg: float = math.inf) -> tuple[float, ...] | None:
-        """Reads ``<base>_deg`` or ``<base>_rad`` (exactly one) and returns radians."""
-        deg, rad = f"{base}_deg", f"{base}_rad"
-        has_deg = self.get(deg, required=False) is not None
-        has_rad = self.get(rad, required=False) is not None
-        if has_deg and has_rad:
-            raise self.fail(rad, self.get(rad), f"absent when '{deg}' is given (give one of them)")
-        if not has_deg and not has_rad:
-            if required:
-                raise self.fail(deg, "<missing>", f"a list of {n} angles [deg] (or '{rad}' [rad])")
-            return None
-        if has_deg:
-            vals = self.vector(deg, n, unit=" [deg]", lo=lo_deg, hi=hi_deg)
-            return tuple(math.radians(v) for v in vals)
-        return self.vector(rad, n, unit=" [rad]", lo=math.radians(lo_deg), hi=math.radians(hi_deg))
+def _angles_rad(source: str, section: Mapping[str, Any], path: str, prefix: str, n: int,
+                default: tuple[float, ...] | None = None) -> tuple[float, ...]:
+    """Radians from ``<prefix>_deg`` or ``<prefix>_rad`` (exactly one, or neither when there is a default)."""
+    deg, rad = section.get(f"{prefix}_deg"), section.get(f"{prefix}_rad")
+    if deg is not None and rad is not None:
+        raise CalibrationError.invalid(source, f"{path}.{prefix}_rad", rad,
+                                       f"absent when '{path}.{prefix}_deg' is given (give one of them)")
+    if deg is not None:
+        return tuple(math.radians(float(v)) for v in deg)
+    if rad is not None:
+        return tuple(float(v) for v in rad)
+    if default is None:
+        raise CalibrationError.invalid(source, f"{path}.{prefix}_deg", MISSING,
+                                       f"a list of {n} angles [deg] (or '{path}.{prefix}_rad' [rad])")
+    return default
 
 
 def load_station(path: str | Path) -> Station:
     """Read and validate a station calibration file, or a shipped station by name (``lab_sim``, ``lab_real``).
 
+    The file is read and parsed by the strict loader (:mod:`ur3hanoi.io.yaml_loader`) and checked against
+    :data:`STATION_SCHEMA`.
+
     Raises:
-        CalibrationError: the file is missing or unreadable, or a field is missing or out of range; the message
-            names the file, the field, the bad value and what is allowed.
+        CalibrationError: the file is missing, unreadable, not strict YAML, has an unknown, missing or duplicate
+            key, or a value of the wrong type or out of range; the message names the file, the field, the bad
+            value and what is allowed.
     """
-    p = station_file(path)
     source = str(path)
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        names = ", ".join(station_names())
-        raise CalibrationError(source, "<file>", str(p), f"a readable calibration file ({exc.strerror}) or a "
-                               f"shipped station name ({names})") from None
-    try:
-        data = yaml.safe_load(raw)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}" if mark is not None else "?"
-        raise CalibrationError(source, "<file>", where, "valid YAML") from None
-    if not isinstance(data, Mapping):
-        raise CalibrationError(source, "<file>", type(data).__name__, "a YAML mapping of calibration fields")
-    station = parse_station(data, source)
-    return replace(station, sha256=hashlib.sha256(raw).hexdigest())
+    doc = load_yaml_file(station_file(path), what="calibration file", error=CalibrationError, source=source,
+                         missing_hint=f"; shipped stations: {', '.join(station_names())}")
+    station = parse_station(doc.data, source)
+    return replace(station, sha256=doc.sha256)
 
 
-def parse_station(data: Mapping[str, Any], source: str = "<memory>") -> Station:
-    """Build a :class:`Station` from parsed YAML (see the module docstring for the fields)."""
-    r = _Reader(source, data)
-    name = r.get("name", required=False, default=Path(source).stem)
-    if not isinstance(name, str) or not name:
-        raise r.fail("name", name, "a non-empty string")
-    layout = r.get("layout")
-    if layout not in LAYOUTS:
-        raise r.fail("layout", layout, f"one of {LAYOUTS}")
+def parse_station(data: Any, source: str = "<memory>") -> Station:
+    """Build a :class:`Station` from a parsed calibration document (see the module docstring for the fields).
 
-    base_xyz = r.vector("robot.base_xyz", 3, unit=" [m]")
-    base_rpy = r.angles("robot.base_rpy", 3, required=False) or (0.0, 0.0, 0.0)
-    elbow_deg = r.get("robot.elbow_limit_deg", required=False, default=360.0)
-    elbow = math.radians(r.number("robot.elbow_limit_deg", elbow_deg, 0.0, 360.0, lo_open=True))
+    Raises:
+        CalibrationError: the document does not match :data:`STATION_SCHEMA` or fails a cross-field check.
+    """
+    validate_schema(data, STATION_SCHEMA, source, CalibrationError)
+    robot, tool, blocks, grid = data["robot"], data["tool"], data["blocks"], data["grid"]
+    name = data.get("name", printable(Path(source).stem, 255))
+    layout = data["layout"]
+
+    base_rpy = _angles_rad(source, robot, "robot", "base_rpy", 3, default=(0.0, 0.0, 0.0))
+    elbow = math.radians(float(robot.get("elbow_limit_deg", 360.0)))
     limits = JointLimits.ur3(elbow_limit=elbow)
-    q_home = r.angles("robot.home", N_JOINTS)
-    assert q_home is not None
+    q_home = _angles_rad(source, robot, "robot", "home", N_JOINTS)
+    tool_rpy = _angles_rad(source, tool, "tool", "rpy", 3)
+    tool_offset = ToolOffset(parent=tool["parent"], xyz=_vec3(tool["xyz"]), rpy=_vec3(tool_rpy))
+    tool_yaw = math.radians(float(tool["yaw_deg"]))
 
-    parent = r.get("tool.parent")
-    if parent not in FLANGE_FRAMES:
-        raise r.fail("tool.parent", parent, f"one of {FLANGE_FRAMES}")
-    tool_xyz = r.vector("tool.xyz", 3, unit=" [m]", lo=-0.5, hi=0.5)
-    tool_rpy = r.angles("tool.rpy", 3)
-    assert tool_rpy is not None
-    tool = ToolOffset(parent=parent, xyz=_vec3(tool_xyz), rpy=_vec3(tool_rpy))
-    yaw_deg = r.get("tool.yaw_deg")
-    tool_yaw = math.radians(r.number("tool.yaw_deg", yaw_deg, -360.0, 360.0, what="an angle [deg]"))
+    block_size = float(blocks["size"])
+    depth = float(blocks["contact_depth"])
+    if depth > block_size:
+        raise CalibrationError.invalid(source, "blocks.contact_depth", blocks["contact_depth"],
+                                       f"a length [m] in [0, {block_size:g}] (at most blocks.size)")
 
-    block_size = r.number("blocks.size", r.get("blocks.size"), 0.0, 0.2, lo_open=True, what="a length [m]")
-    depth = r.number("blocks.contact_depth", r.get("blocks.contact_depth"), 0.0, block_size,
-                     what="a length [m] (at most blocks.size)")
-
-    n_towers = r.integer("grid.towers", 2, MAX_TOWERS)
-    n_heights = r.integer("grid.heights", 1, MAX_HEIGHTS)
-    explicit = r.get("grid.tower_origins", required=False)
+    n_towers, n_heights = int(grid["towers"]), int(grid["heights"])
+    explicit = grid.get("tower_origins")
     if explicit is not None:
-        for key in ("grid.origin", "grid.tower_step"):
-            if r.get(key, required=False) is not None:
-                raise r.fail(key, r.get(key), "absent when 'grid.tower_origins' is given (give one form)")
-        if not isinstance(explicit, list) or len(explicit) != n_towers:
-            raise r.fail("grid.tower_origins", explicit, f"a list of grid.towers = {n_towers} points [x, y, z]")
-        origins = tuple(
-            _vec3(r.vector(f"grid.tower_origins[{i}]", 3, value=p, unit=" [m]")) for i, p in enumerate(explicit)
-        )
+        for key in ("origin", "tower_step"):
+            if key in grid:
+                raise CalibrationError.invalid(source, f"grid.{key}", grid[key],
+                                               "absent when 'grid.tower_origins' is given (give one form)")
+        if len(explicit) != n_towers:
+            raise CalibrationError.invalid(source, "grid.tower_origins", explicit,
+                                           f"a list of grid.towers = {n_towers} points [x, y, z]")
+        origins = tuple(_vec3(p) for p in explicit)
     else:
-        origin = np.array(r.vector("grid.origin", 3, unit=" [m]"))
-        step = np.array(r.vector("grid.tower_step", 3, unit=" [m]"))
+        for key in ("origin", "tower_step"):
+            if key not in grid:
+                raise CalibrationError.invalid(source, f"grid.{key}", MISSING,
+                                               "a list of 3 numbers [m] (or 'grid.tower_origins' instead of "
+                                               "'grid.origin' and 'grid.tower_step')")
+        origin = np.array(grid["origin"], dtype=float)
+        step = np.array(grid["tower_step"], dtype=float)
         origins = tuple(_vec3(origin + t * step) for t in range(n_towers))
-    height_step = _vec3(r.vector("grid.height_step", 3, unit=" [m]"))
-    approach = r.number("grid.approach", r.get("grid.approach"), 0.0, 0.5, lo_open=True, what="a length [m]")
 
     station = Station(
-        name=name, layout=layout, base_xyz=_vec3(base_xyz), base_rpy=_vec3(base_rpy), q_home=tuple(q_home),
-        limits=limits, tool=tool, tool_yaw=tool_yaw, block_size=block_size, contact_depth=depth,
-        tower_origins=origins, height_step=height_step, n_heights=n_heights, approach=approach, source=source,
+        name=name, layout=layout, base_xyz=_vec3(robot["base_xyz"]), base_rpy=_vec3(base_rpy), q_home=q_home,
+        limits=limits, tool=tool_offset, tool_yaw=tool_yaw, block_size=block_size, contact_depth=depth,
+        tower_origins=origins, height_step=_vec3(grid["height_step"]), n_heights=n_heights,
+        approach=float(grid["approach"]), source=source,
     )
     validate(station)
     return station
@@ -290,29 +276,29 @@ def parse_station(data: Mapping[str, Any], source: str = "<memory>") -> Station:
 
 def validate(s: Station) -> None:
     """Cross-field checks: limits, grid geometry per layout, block overlaps. Raises CalibrationError."""
+    fail = CalibrationError.invalid
     src = s.source
     if not s.limits.within_position(s.q_home_array):
-        raise CalibrationError(src, "robot.home_deg", [round(math.degrees(v), 6) for v in s.q_home],
-                               "joint angles within the UR3 limits (+-360 deg; elbow within robot.elbow_limit_deg)")
+        raise fail(src, "robot.home_deg", [round(math.degrees(v), 6) for v in s.q_home],
+                   "joint angles within the UR3 limits (+-360 deg; elbow within robot.elbow_limit_deg)")
     step = np.array(s.height_step)
     horiz, vert = float(np.linalg.norm(step[:2])), float(step[2])
     if s.n_heights > 1 or np.linalg.norm(step) > 0:
         if s.layout == "flat":
             if abs(vert) > 1e-6 or horiz < s.block_size:
-                raise CalibrationError(src, "grid.height_step", list(s.height_step),
-                                       f"a horizontal vector (z = 0) at least blocks.size = {s.block_size} m long "
-                                       "for layout 'flat'")
+                raise fail(src, "grid.height_step", list(s.height_step),
+                           f"a horizontal vector (z = 0) at least blocks.size = {s.block_size} m long for layout "
+                           "'flat'")
         elif not (0.9 * s.block_size <= vert <= 1.1 * s.block_size and horiz <= 0.25 * s.block_size):
-            raise CalibrationError(src, "grid.height_step", list(s.height_step),
-                                   f"a vertical vector of about one block ({s.block_size} m, +-10%) "
-                                   "for layout 'stacked'")
+            raise fail(src, "grid.height_step", list(s.height_step),
+                       f"a vertical vector of about one block ({s.block_size} m, +-10%) for layout 'stacked'")
     # Towers must not overlap: their height-0 slots at least one block apart in the table plane.
     for i, a in enumerate(s.tower_origins):
         for j in range(i + 1, s.n_towers):
             b = s.tower_origins[j]
             if np.linalg.norm(np.subtract(a, b)[:2]) < s.block_size:
-                raise CalibrationError(src, "grid.tower_origins", [list(a), list(b)],
-                                       f"towers {i} and {j} at least blocks.size = {s.block_size} m apart in xy")
+                raise fail(src, "grid.tower_origins", [list(a), list(b)],
+                           f"towers {i} and {j} at least blocks.size = {s.block_size} m apart in xy")
 
 
 def station_to_dict(s: Station) -> dict[str, Any]:

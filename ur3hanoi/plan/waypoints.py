@@ -12,7 +12,7 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.plan.vertical import VerticalPath, vertical_path
 from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import Station
-from ur3hanoi.table import generate_table
+from ur3hanoi.waypoints import generate_table
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,73 @@
+"""Taught-points files and tables used as taught points: strict schema, unit mix-ups, radians out."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+import pytest
+
+from ur3hanoi.errors import TableError, TaughtPointsError
+from ur3hanoi.grid import ABOVE, ON
+from ur3hanoi.resources import TAUGHT_EXAMPLE, stations_dir
+from ur3hanoi.taught import load_taught, parse_taught, taught_from_table
+
+from .conftest import REPO
+
+HOME_DEG = [120, -90, 90, -90, -90, 0]
+
+
+def test_load_taught_converts_degrees(tmp_path: Path) -> None:
+    f = tmp_path / "t.yaml"
+    f.write_text("units: deg\npoints:\n- {tower: 0, height: 1, pose: above, q: [120, -90, 90, -90, -90, 0]}\n")
+    taught = load_taught(f)
+    (p,) = taught.points
+    assert (p.tower, p.height, p.k) == (0, 1, ABOVE)
+    assert p.q == pytest.approx([math.radians(v) for v in HOME_DEG], abs=1e-15)
+    assert taught.sha256 == hashlib.sha256(f.read_bytes()).hexdigest()
+
+
+def test_shipped_example_loads() -> None:
+    taught = load_taught(stations_dir() / TAUGHT_EXAMPLE)
+    assert len(taught.points) == 5
+    assert [p.k for p in taught.points] == [ON, ON, ON, ON, ABOVE]
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        ({"units": "deg", "point": []}, "field 'point' is unknown: did you mean 'points'?"),
+        ({"units": "deg", "points": [{"tower": 0, "height": 0, "q": HOME_DEG, "pose": "on", "tilt": 0}]},
+         "field 'points[0].tilt' is unknown: expected one of points[0].tower, points[0].height, points[0].pose, "
+         "points[0].q"),
+        ({"units": "deg", "points": [{"tower": 0, "height": 0}]},
+         "field 'points[0].q' is missing: expected a list of 6 numbers, each a joint value (in 'units') in "
+         "[-360, 360]"),
+        ({"units": "deg", "points": [{"tower": -1, "height": 0, "q": HOME_DEG}]},
+         "field 'points[0].tower' = -1 is invalid: expected a 0-based tower index in [0, 9]"),
+        ({"units": "deg", "points": [{"tower": 0, "height": 0, "q": [*HOME_DEG[:5], float("nan")]}]},
+         "field 'points[0].q[5]' = nan is invalid"),
+        ({"units": "deg", "points": []}, "field 'points' = [] is invalid: expected a list of 1..1000 points"),
+        ({"units": "rad", "points": [{"tower": 0, "height": 0, "q": HOME_DEG}]},
+         "points[0] (tower 0 height 0 on): joint value 120 is outside +-2pi with units rad: looks like degrees"),
+    ],
+    ids=["typo-points", "unknown-point-key", "missing-q", "negative-tower", "nan", "empty", "degrees-as-rad"],
+)
+def test_invalid_taught_points_name_file_and_field(data: object, message: str) -> None:
+    with pytest.raises(TaughtPointsError) as info:
+        parse_taught(data, "t.yaml")
+    assert str(info.value).startswith(f"t.yaml: {message}")
+
+
+def test_taught_from_table_uses_every_entry() -> None:
+    taught = taught_from_table(REPO / "tables/lab2_data.yaml", "real_pos")
+    assert len(taught.points) == 18
+    assert [(p.tower, p.height, p.k) for p in taught.points[:3]] == [(0, 0, ON), (0, 0, ABOVE), (0, 1, ON)]
+
+
+def test_taught_from_table_refuses_a_degree_table(tmp_path: Path) -> None:
+    path = tmp_path / "t.yaml"
+    path.write_text("real_pos: [[[[120, -90, 90, -90, -90, 0], [120, -90, 90, -90, -90, 0]]]]\n")
+    with pytest.raises(TableError, match=r"real_pos\[0\]\[0\]\[0\]\[0\]' = 120 is invalid: expected a joint angle"):
+        taught_from_table(path, "real_pos")

@@ -1,0 +1,102 @@
+"""The ``ur3hanoi`` parser and entry point: one line on stderr for every error, never a traceback.
+
+A library error (:class:`~ur3hanoi.errors.Ur3HanoiError`) prints ``ur3hanoi: error: <message>`` and exits with the
+code of :data:`ur3hanoi.cli.exit_codes.EXIT_CODES`; a bad option prints ``ur3hanoi <command>: error: argument
+...`` and exits 2; anything unexpected prints ``ur3hanoi <command>: internal error: ...`` and exits 70, and
+``--debug`` shows its traceback instead.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+from typing import NoReturn
+
+from ur3hanoi import __version__
+from ur3hanoi.cli import calibrate, check_table, exit_codes, plan, solve, tables
+from ur3hanoi.errors import Ur3HanoiError, printable
+
+_COMMANDS = (tables, check_table, calibrate, plan, solve)
+_DEBUG_HELP = "on an internal error, show the Python traceback (for a bug report)"
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``ur3hanoi plan: error: argument --rate: ... (see ur3hanoi plan --help)``."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(exit_codes.BAD_INPUT, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
+
+
+def _one_line(text: object) -> str:
+    return printable(" ".join(str(text).split()), 2000)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``ur3hanoi`` parser with its five commands."""
+    parser = _Parser(prog="ur3hanoi", description="UR3 Tower of Hanoi lab toolkit.")
+    parser.add_argument("--version", action="version", version=f"ur3hanoi {__version__}")
+    parser.add_argument("--debug", action="store_true", help=_DEBUG_HELP)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for command in _COMMANDS:
+        command.add(sub)
+    for p in sub.choices.values():
+        # Also accepted after the command; SUPPRESS keeps a --debug given before it.
+        p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=_DEBUG_HELP)
+    return parser
+
+
+def help_markdown(width: int = 100) -> str:
+    """The README's CLI reference: ``--help`` of the command and of every subcommand, at a fixed width."""
+    old = os.environ.get("COLUMNS")
+    os.environ["COLUMNS"] = str(width)  # argparse wraps to the terminal width: pin it for a stable text
+    try:
+        parser = build_parser()
+        parts = ["```text", "$ ur3hanoi --help", parser.format_help().rstrip(), "```"]
+        sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+        for name, p in sub.choices.items():
+            parts += ["", f"#### `ur3hanoi {name}`", "", "```text", p.format_help().rstrip(), "```"]
+    finally:
+        if old is None:
+            del os.environ["COLUMNS"]
+        else:
+            os.environ["COLUMNS"] = old
+    return "\n".join(parts) + "\n"
+
+
+def _exit_status(code: object) -> int:
+    if code is None:
+        return exit_codes.OK
+    return code if isinstance(code, int) else exit_codes.BAD_INPUT
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``ur3hanoi`` with ``argv`` (default ``sys.argv[1:]``); returns the exit code, never raises
+    (except with ``--debug`` on an internal error)."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a usage error already printed
+        return _exit_status(exc.code)
+    prog = f"ur3hanoi {args.command}"
+    try:
+        return int(args.func(args))
+    except Ur3HanoiError as exc:
+        print(f"ur3hanoi: error: {_one_line(exc)}", file=sys.stderr)
+        return exit_codes.exit_code_for(exc)
+    except KeyboardInterrupt:
+        print(f"{prog}: interrupted", file=sys.stderr)
+        return exit_codes.INTERRUPTED
+    except BrokenPipeError:
+        # The reader of stdout went away (`| head`): nothing more to say; keep Python quiet at exit too.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+        return exit_codes.BROKEN_PIPE
+    except Exception as exc:
+        if args.debug:
+            raise
+        print(f"{prog}: internal error: {type(exc).__name__}: {_one_line(exc) or '(no message)'} (a bug: rerun "
+              "with --debug for the traceback)", file=sys.stderr)
+        return exit_codes.INTERNAL

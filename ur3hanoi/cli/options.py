@@ -1,0 +1,96 @@
+"""Every numeric command-line option with its valid range, parsed and checked in this one place.
+
+Each option's range is a :class:`~ur3hanoi.io.schema.Number` (the same range type the input files use), so the
+message says what is allowed, e.g. ``argument --rate: '1e-9' is invalid: expected a sample rate [Hz] in [1,
+10000]``. Cross-option checks that need the station (blocks against the grid, the size of a plan) are here too.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+
+from ur3hanoi.errors import Ur3HanoiError, quote
+from ur3hanoi.io.schema import Number
+from ur3hanoi.station import MAX_HEIGHTS, MAX_TOWERS
+
+
+class UsageError(Ur3HanoiError):
+    """A command-line option is missing, invalid, or inconsistent with another one (exit code 2)."""
+
+
+MAX_BLOCKS = 10
+"""Most blocks a plan or a solve takes (1023 moves)."""
+
+MAX_PLAN_SAMPLES = 5_000_000
+"""Most trajectory samples a plan may hold (about 1 GB), estimated before planning (see :func:`check_plan_size`)."""
+
+SECONDS_PER_MOVE = 8.0
+"""Upper estimate of one move's motion time [s] at full speed (the lab's moves take 5-6 s), for the estimate."""
+
+SPEED = Number(0.01, 1.0, what="a fraction of the joint speed, acceleration and jerk limits")
+RATE = Number(1.0, 10000.0, unit="Hz", what="a sample rate")
+DWELL = Number(0.0, 10.0, unit="s", what="a dwell time")
+SEED = Number(0, 2**32 - 1, integer=True, what="a seed")
+TOL_MM = Number(0.0, 1000.0, lo_open=True, unit="mm", what="a position tolerance")
+TOL_DEG = Number(0.0, 180.0, lo_open=True, unit="deg", what="an orientation tolerance")
+TOWER = Number(1, MAX_TOWERS, integer=True, what="a tower number (1-based)")
+BLOCKS = Number(1, MAX_BLOCKS, integer=True, what="a number of blocks")
+HEIGHT = Number(1, MAX_HEIGHTS, integer=True, what="a height (1-based)")
+MOVE = Number(1, 2**MAX_BLOCKS - 1, integer=True, what="a move number (1-based)")
+
+_MAX_TEXT = 40  # longer option values are not numbers anyone means (and int() of 5000 digits is refused anyway)
+
+
+def _parse(text: str, integer: bool) -> float | int | None:
+    text = text.strip()
+    if not text or len(text) > _MAX_TEXT:
+        return None
+    try:
+        return int(text, 10) if integer else float(text)
+    except ValueError:
+        return None
+
+
+def option(spec: Number) -> Callable[[str], float | int]:
+    """An argparse ``type=`` that parses a number and checks it against ``spec``."""
+
+    def parse(text: str) -> float | int:
+        value = _parse(text, spec.integer)
+        if value is None or not spec.accepts(value):
+            raise argparse.ArgumentTypeError(f"{quote(text)} is invalid: expected {spec.expected()}")
+        return value
+
+    parse.__name__ = spec.what or "number"
+    return parse
+
+
+def check_blocks(n_blocks: int, n_heights: int, given: bool) -> None:
+    """``n_blocks`` (``--blocks``, or the grid's heights when not ``given``) must be 1..MAX_BLOCKS."""
+    if not 1 <= n_blocks <= MAX_BLOCKS:
+        if given:
+            raise UsageError(f"--blocks {n_blocks} is invalid: expected {BLOCKS.expected()}")
+        raise UsageError(f"the calibration's grid has {n_heights} heights, more blocks than a plan takes "
+                         f"(at most {MAX_BLOCKS}): choose fewer with --blocks")
+
+
+def check_faults(remove_block: int | None, drop_during_move: int | None, n_blocks: int) -> None:
+    """The fault injections must name a height and a move of this instance (1-based)."""
+    n_moves = 2**n_blocks - 1
+    if remove_block is not None and not 1 <= remove_block <= n_blocks:
+        raise UsageError(f"--remove-block {remove_block} is invalid: expected a height 1..{n_blocks}")
+    if drop_during_move is not None and not 1 <= drop_during_move <= n_moves:
+        raise UsageError(f"--drop-during-move {drop_during_move} is invalid: expected a move 1..{n_moves}")
+
+
+def check_plan_size(n_blocks: int, speed: float, dwell_s: float, rate_hz: float) -> None:
+    """Refuse a plan whose samples would not fit in memory, before planning it.
+
+    The estimate is ``moves x (SECONDS_PER_MOVE / speed + 2 dwell) x rate``, an upper bound for the lab's grids.
+    """
+    n_moves = 2**n_blocks - 1
+    estimate = n_moves * (SECONDS_PER_MOVE / speed + 2 * dwell_s) * rate_hz
+    if estimate > MAX_PLAN_SAMPLES:
+        raise UsageError(f"{n_blocks} blocks at --speed {speed:g} and {rate_hz:g} Hz would make about "
+                         f"{estimate:.3g} samples, more than {MAX_PLAN_SAMPLES}: use fewer blocks, a higher "
+                         "--speed or a lower rate")

@@ -1,0 +1,195 @@
+"""``ur3hanoi solve``: run the lab in MuJoCo (plan, execute with suction feedback, verify)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+from pathlib import Path
+
+from ur3hanoi.cli import exit_codes
+from ur3hanoi.cli.common import DEFAULT_CALIBRATION, calibration_ref, input_file, shown
+from ur3hanoi.cli.options import (
+    BLOCKS,
+    HEIGHT,
+    MOVE,
+    SEED,
+    SPEED,
+    TOWER,
+    UsageError,
+    check_blocks,
+    check_faults,
+    check_plan_size,
+    option,
+)
+from ur3hanoi.errors import OutputError, SuctionFaultError, Ur3HanoiError, printable
+
+
+def add(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("solve", help="run the lab in MuJoCo: plan, execute with suction feedback, verify",
+                       description="Solve the Tower of Hanoi in a MuJoCo simulation of the station: the UR3 "
+                                   "follows the planned trajectory, the suction cup grasps by weld, and the "
+                                   "program halts like the lab's (suction off, arm home, exit 3) when a block is "
+                                   "missing or dropped. Towers, heights and moves are numbered from 1. Without "
+                                   "--start/--end it prompts on a terminal like the lab program.")
+    p.add_argument("--start", type=option(TOWER), metavar="S", help="start tower (1-based)")
+    p.add_argument("--end", type=option(TOWER), metavar="E", help="destination tower (1-based)")
+    p.add_argument("--blocks", type=option(BLOCKS), default=None, metavar="N",
+                   help=f"{BLOCKS.expected()} (default: the grid's heights, 3 on the lab)")
+    p.add_argument("--calibration", default=None, metavar="CAL",
+                   help=f"station calibration YAML (default {DEFAULT_CALIBRATION})")
+    p.add_argument("--remove-block", type=option(HEIGHT), metavar="H",
+                   help="fault injection: spawn without the block at height H (1-based), like lab2_spawn.py")
+    p.add_argument("--drop-during-move", type=option(MOVE), metavar="M",
+                   help="fault injection: the suction loses its block in the middle of move M's carry (1-based)")
+    p.add_argument("--speed", type=option(SPEED), default=1.0, metavar="F",
+                   help=f"fraction of the joint speed/acceleration/jerk limits, in [{SPEED.lo:g}, {SPEED.hi:g}] "
+                        "(default 1)")
+    p.add_argument("--seed", type=option(SEED), default=0, metavar="K",
+                   help=f"seed of the suction feedback noise, an integer in [0, {SEED.hi}]")
+    out = p.add_mutually_exclusive_group()
+    out.add_argument("--video", metavar="FILE.mp4",
+                     help="render an MP4 offscreen (needs imageio + imageio-ffmpeg; headless: MUJOCO_GL=egl)")
+    out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR (headless: MUJOCO_GL=egl)")
+    p.add_argument("--view", action="store_true", help="open MuJoCo's interactive viewer (needs a display)")
+    p.add_argument("--json", action="store_true", help="print one JSON object with the outcome on stdout")
+    p.set_defaults(func=run)
+
+
+def prompt_tower(what: str, n_towers: int, exclude: int | None = None) -> int:
+    """Prompt like the lab program until a valid tower (1-based) is entered; returns it 0-based."""
+    choices = " ".join(str(t) for t in range(1, n_towers + 1) if t - 1 != exclude)
+    options = choices.rsplit(" ", 1)
+    label = f"{options[0]} or {options[1]}" if len(options) == 2 else choices
+    while True:
+        try:
+            text = input(f"Enter the {what} tower <{label}> ")
+        except EOFError:
+            raise UsageError(f"no {what} tower entered (end of input)") from None
+        text = text.strip()
+        if text.isdigit() and len(text) < 4 and 1 <= int(text) <= n_towers and int(text) - 1 != exclude:
+            return int(text) - 1
+        print(f"Please just enter the character {label}\n")
+
+
+def _progress(fraction: float, label: str) -> None:
+    width = 30
+    filled = round(width * fraction)
+    end = "\n" if fraction >= 1.0 else ""
+    print(f"\r[{'#' * filled}{'.' * (width - filled)}] {100 * fraction:5.1f}% {label:<12}", end=end,
+          file=sys.stderr, flush=True)
+
+
+def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
+    """Refuse a video or frames path that cannot be written, before simulating anything."""
+    from ur3hanoi.io.atomic import check_output
+
+    if args.video:
+        check_output(args.video, inputs=inputs)
+    if args.frames:
+        try:
+            Path(args.frames).mkdir(parents=True, exist_ok=True)
+        except (OSError, ValueError) as exc:
+            problem = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+            raise OutputError(f"cannot write frames into {printable(args.frames)}: {problem}") from None
+        if not os.access(args.frames, os.W_OK | os.X_OK):
+            raise OutputError(f"cannot write frames into {printable(args.frames)}: the directory is not writable")
+
+
+def _towers(args: argparse.Namespace, n_towers: int) -> tuple[int, int]:
+    """Start and end tower, 0-based: from the options, or prompted for on a terminal."""
+    if args.start is not None and args.end is not None:
+        return args.start - 1, args.end - 1
+    if not sys.stdin.isatty():
+        raise UsageError("--start and --end are required when stdin is not a terminal "
+                         f"(towers 1..{n_towers}), e.g. ur3hanoi solve --start 1 --end 3")
+    start = args.start - 1 if args.start is not None else prompt_tower("start", n_towers)
+    end = args.end - 1 if args.end is not None else prompt_tower("end", n_towers, exclude=start)
+    return start, end
+
+
+def run(args: argparse.Namespace) -> int:
+    import json
+
+    from ur3hanoi.hanoi import validate_instance
+    from ur3hanoi.plan import PlanConfig, plan_solve
+    from ur3hanoi.station import load_station
+
+    inputs = [input_file(calibration_ref(args.calibration))]
+    station = load_station(calibration_ref(args.calibration))
+    n_towers = station.n_towers
+    n_blocks = station.n_heights if args.blocks is None else args.blocks
+    check_blocks(n_blocks, station.n_heights, given=args.blocks is not None)
+    start, end = _towers(args, n_towers)
+    validate_instance(n_blocks, start, end, n_towers, station.n_heights)
+    check_faults(args.remove_block, args.drop_during_move, n_blocks)
+    plan_config = PlanConfig(speed=args.speed)
+    check_plan_size(n_blocks, args.speed, plan_config.dwell_s, plan_config.rate_hz)
+    _check_render_outputs(args, inputs)
+    if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
+        os.environ["MUJOCO_GL"] = "egl"  # headless offscreen rendering (read when the GL context is created)
+
+    from ur3hanoi.sim import (
+        Faults,
+        OffscreenRecorder,
+        SimConfig,
+        ViewerSink,
+        build_task_scene,
+        display_available,
+        run_plan,
+    )
+
+    if args.view and display_available() is not None:
+        raise UsageError(f"--view cannot open the MuJoCo viewer: {display_available()}; "
+                         "use --video FILE.mp4 or --frames DIR")
+    faults = Faults(
+        remove_block=None if args.remove_block is None else args.remove_block - 1,
+        drop_during_move=None if args.drop_during_move is None else args.drop_during_move - 1,
+    )
+    config = SimConfig(seed=args.seed)
+    plan = plan_solve(station, start, end, n_blocks, plan_config)
+    scene = build_task_scene(station, start, n_blocks, faults.remove_block, config.scene)
+    sink: object | None = None
+    fault: Ur3HanoiError | None = None
+    try:
+        if args.view:
+            sink = ViewerSink(scene.model, scene.data)
+        elif args.video or args.frames:
+            sink = OffscreenRecorder(station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
+                                     video=Path(args.video) if args.video else None)
+        progress = _progress if sys.stderr.isatty() and not args.view else None
+        try:
+            result = run_plan(plan, faults, config, frames=sink, progress=progress,  # type: ignore[arg-type]
+                              scene=scene, realtime=args.view)
+        except SuctionFaultError as exc:
+            # A halted run still has a result to report (the final block positions, the halt).
+            if exc.result is None:
+                raise
+            result, fault = exc.result, exc
+    finally:
+        if sink is not None:
+            sink.close()  # type: ignore[attr-defined]
+
+    if args.json:
+        print(json.dumps(result.as_dict()))
+    else:
+        print(f"{result.status}: {result.moves_completed}/{result.moves_total} moves, tower {start + 1} -> "
+              f"{end + 1}, {len(result.final_blocks)} blocks on {shown(station.name)}")
+        for b in result.final_blocks:
+            where = "in no slot"
+            if b.tower is not None and b.height is not None:
+                where = f"tower {b.tower + 1} height {b.height + 1}"
+            print(f"  block {b.block + 1} ({b.as_dict()['colour']}): {where} at "
+                  f"[{b.xyz[0]:.4f}, {b.xyz[1]:.4f}, {b.xyz[2]:.4f}] m")
+        print(f"  sim {result.sim_time_s:.2f} s in {result.wall_time_s:.2f} s wall ({result.realtime_factor:.1f}x "
+              f"real time), max tracking error {math.degrees(result.max_tracking_error_rad):.3f} deg, suction "
+              f"{'on' if result.suction_on_at_end else 'off'}, {'at' if result.at_home_at_end else 'not at'} home")
+        if args.video or args.frames:
+            print(f"  wrote {sink.count} frames to {shown(args.video or args.frames)}")  # type: ignore[union-attr]
+    if fault is not None:
+        print(f"ur3hanoi: error: {' '.join(str(fault).split())}", file=sys.stderr)
+        return exit_codes.exit_code_for(fault)
+    if result.error is not None:
+        print(f"ur3hanoi: error: {' '.join(str(result.error).split())}", file=sys.stderr)
+    return int(result.exit_code)

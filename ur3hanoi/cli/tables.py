@@ -1,0 +1,39 @@
+"""``ur3hanoi tables``: generate a lab table key from a calibration by IK and write it into the lab file."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ur3hanoi.cli.common import SYMLINK_NOTE, input_file, shown
+from ur3hanoi.labfile import TABLE_KEYS
+
+
+def add(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("tables", help="generate a lab2_data.yaml waypoint table from a calibration by IK",
+                       description="Generate Q[tower][height][0 = on, 1 = above] (6 joint angles [rad]) by IK "
+                                   "and write it under --key into FILE, keeping every other key of FILE.")
+    p.add_argument("calibration", help="station calibration YAML, or a shipped station name (lab_sim, lab_real)")
+    p.add_argument("--key", required=True, choices=TABLE_KEYS, help="table key to (re)generate")
+    p.add_argument("-o", "--output", required=True, metavar="FILE",
+                   help=f"lab-format YAML file to create/update ({SYMLINK_NOTE}; concurrent runs are serialized)")
+    p.add_argument("--solver", default="pinocchio", choices=["pinocchio", "placo"], help="IK solver")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ur3hanoi.io.atomic import check_output
+    from ur3hanoi.labfile import write_table
+    from ur3hanoi.station import load_station
+    from ur3hanoi.waypoints import generate_table
+
+    inputs = [input_file(args.calibration)]
+    check_output(args.output, inputs=inputs)  # fail before the IK, not after
+    station = load_station(args.calibration)
+    table = generate_table(station, args.solver)
+    write_table(args.output, table, args.key, calibration_label=Path(args.calibration).as_posix(), inputs=inputs)
+    print(
+        f"wrote {args.key} ({station.n_towers} towers x {station.n_heights} heights x 2) to {shown(args.output)}: "
+        f"max IK error {table.max_position_error:.2e} m, {table.max_orientation_error:.2e} rad ({args.solver})"
+    )
+    return 0

@@ -1,0 +1,221 @@
+"""Declarative schemas for the YAML input files, and the one validator that checks a parsed document.
+
+A schema says, for every field, its type and valid range; :func:`validate` walks a parsed document against it
+and raises the file kind's :class:`~ur3hanoi.errors.InputError` naming the file, the field path
+(``grid.tower_origins[2][1]``), the bad value (shortened) and what is allowed. Unknown keys are errors with the
+nearest valid key suggested (``robot.base_rpy`` -> did you mean ``robot.base_rpy_deg``?). Numbers must be finite
+(no ``.nan``/``.inf``); booleans are not numbers. Cross-field rules (a ``_deg``/``_rad`` pair, a count matching a
+list) stay with the file kind's parser, after this check.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from ur3hanoi.errors import MISSING, InputError, printable, quote
+from ur3hanoi.io.limits import MAX_LIST_ITEMS
+
+
+def _fmt(x: float) -> str:
+    """``0.2``, ``360``, ``4294967295`` (whole numbers in full, others shortest)."""
+    if float(x).is_integer() and abs(x) < 1e16:
+        return str(int(x))
+    return f"{x:g}"
+
+
+@dataclass(frozen=True)
+class Number:
+    """A finite number (or an integer) in a range. ``unit`` is shown in messages (``"m"`` -> ``[m]``)."""
+
+    lo: float = -math.inf
+    hi: float = math.inf
+    lo_open: bool = False
+    hi_open: bool = False
+    unit: str = ""
+    integer: bool = False
+    what: str = ""
+
+    def expected(self) -> str:
+        noun = self.what or ("an integer" if self.integer else "a number")
+        unit = f" [{self.unit}]" if self.unit else ""
+        if math.isinf(self.lo) and math.isinf(self.hi):
+            return f"{noun}{unit}" if self.integer else f"a finite {noun.split(' ', 1)[-1]}{unit}"
+        lo = "(" if self.lo_open or math.isinf(self.lo) else "["
+        hi = ")" if self.hi_open or math.isinf(self.hi) else "]"
+        return f"{noun}{unit} in {lo}{_fmt(self.lo)}, {_fmt(self.hi)}{hi}"
+
+    def accepts(self, value: Any) -> bool:
+        """True for a finite number (an int if ``integer``) inside the range; never for a bool."""
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            return False
+        if self.integer and not isinstance(value, int):
+            return False
+        x: float | int = value
+        if not isinstance(value, int) or not self.integer:
+            try:
+                x = float(value)
+            except OverflowError:  # an int too large for a float is outside any finite range
+                return False
+            if not math.isfinite(x):
+                return False
+        return not (x < self.lo or x > self.hi or (self.lo_open and x == self.lo) or (self.hi_open and x == self.hi))
+
+
+@dataclass(frozen=True)
+class Vector:
+    """A list of exactly ``n`` numbers, each checked by ``item``."""
+
+    n: int
+    item: Number
+
+    def expected(self) -> str:
+        return f"a list of {self.n} numbers, each {self.item.expected()}"
+
+
+@dataclass(frozen=True)
+class Choice:
+    """One of a few strings."""
+
+    options: tuple[str, ...]
+
+    def expected(self) -> str:
+        return f"one of {', '.join(self.options)}"
+
+
+@dataclass(frozen=True)
+class Text:
+    """A non-empty single-line string of at most ``max_len`` characters."""
+
+    max_len: int = 100
+
+    def expected(self) -> str:
+        return f"a non-empty single-line string of at most {self.max_len} characters"
+
+    def accepts(self, value: Any) -> bool:
+        return isinstance(value, str) and bool(value.strip()) and len(value) <= self.max_len and value.isprintable()
+
+
+@dataclass(frozen=True)
+class ListOf:
+    """A list of ``min_items`` .. ``max_items`` items, each checked by ``item``."""
+
+    item: Spec
+    min_items: int = 1
+    max_items: int = MAX_LIST_ITEMS
+    what: str = "items"
+
+    def expected(self) -> str:
+        if self.min_items == self.max_items:
+            return f"a list of exactly {self.min_items} {self.what}"
+        return f"a list of {self.min_items}..{self.max_items} {self.what}"
+
+
+@dataclass(frozen=True)
+class Field:
+    """One key of a :class:`Record`."""
+
+    spec: Spec
+    required: bool = True
+
+
+@dataclass(frozen=True)
+class Record:
+    """A mapping with exactly the given keys (optional ones may be absent); any other key is an error."""
+
+    fields: Mapping[str, Field] = field(default_factory=dict)
+
+    def expected(self) -> str:
+        return f"a mapping with keys {', '.join(self.fields)}"
+
+
+Spec = Number | Vector | Choice | Text | ListOf | Record
+
+
+def _join(path: str, key: str) -> str:
+    return f"{path}.{key}" if path else key
+
+
+def suggest(key: object, valid: list[str]) -> str | None:
+    """The valid key nearest to ``key`` (difflib ratio >= 0.6; ties go to the earlier key: ``_deg`` before
+    ``_rad``), or None."""
+    text = str(key)[:200]
+    best, best_score = None, 0.6
+    for name in valid:
+        matcher = difflib.SequenceMatcher(None, text, name)
+        if matcher.real_quick_ratio() >= best_score and matcher.quick_ratio() >= best_score:
+            score = matcher.ratio()
+            if score > best_score or (best is None and score >= best_score):
+                best, best_score = name, score
+    return best
+
+
+class _Validator:
+    def __init__(self, source: str, error: type[InputError]) -> None:
+        self.source = source
+        self.error = error
+
+    def fail(self, path: str, value: Any, allowed: str) -> InputError:
+        if not path:
+            got = "an empty document" if value is None else f"a {type(value).__name__}"
+            return self.error.file(self.source, f"expected {allowed}, got {got}")
+        return self.error.invalid(self.source, path, value, allowed)
+
+    def check(self, value: Any, spec: Spec, path: str) -> None:
+        if isinstance(spec, Number):
+            if not spec.accepts(value):
+                raise self.fail(path, value, spec.expected())
+        elif isinstance(spec, Vector):
+            if not isinstance(value, list) or len(value) != spec.n:
+                raise self.fail(path, value, spec.expected())
+            for i, v in enumerate(value):
+                self.check(v, spec.item, f"{path}[{i}]")
+        elif isinstance(spec, Choice):
+            if not isinstance(value, str) or value not in spec.options:
+                raise self.fail(path, value, spec.expected())
+        elif isinstance(spec, Text):
+            if not spec.accepts(value):
+                raise self.fail(path, value, spec.expected())
+        elif isinstance(spec, ListOf):
+            if not isinstance(value, list) or not spec.min_items <= len(value) <= spec.max_items:
+                raise self.fail(path, value, spec.expected())
+            for i, v in enumerate(value):
+                self.check(v, spec.item, f"{path}[{i}]")
+        else:
+            self.record(value, spec, path)
+
+    def record(self, value: Any, spec: Record, path: str) -> None:
+        if not isinstance(value, dict):
+            raise self.fail(path, value, spec.expected())
+        names = list(spec.fields)
+        for key in value:
+            if not isinstance(key, str) or key not in spec.fields:
+                self.unknown(key, names, path)
+        for name, f in spec.fields.items():
+            if name in value:
+                self.check(value[name], f.spec, _join(path, name))
+            elif f.required:
+                raise self.error.invalid(self.source, _join(path, name), MISSING, f.spec.expected())
+
+    def unknown(self, key: Any, names: list[str], path: str) -> None:
+        shown = printable(key, 60) if isinstance(key, str) else quote(key)
+        name = _join(path, shown)
+        near = suggest(key, names)
+        where = f"{printable(self.source)}: field '{name}' is unknown"
+        if near is not None:
+            allowed = f"did you mean '{_join(path, near)}'?"
+        else:
+            allowed = f"expected one of {', '.join(_join(path, n) for n in names)}"
+        raise self.error(f"{where}: {allowed}", source=self.source, field=name, value=key, allowed=allowed)
+
+
+def validate(data: Any, schema: Spec, source: str, error: type[InputError] = InputError, path: str = "") -> None:
+    """Check the parsed document ``data`` (or the value at field ``path`` of one) against ``schema``.
+
+    Raises:
+        error: the first problem found, naming ``source``, the field path, the value and what is allowed.
+    """
+    _Validator(source, error).check(data, schema, path)

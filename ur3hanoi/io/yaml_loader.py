@@ -1,0 +1,167 @@
+"""The one YAML loader of ur3hanoi: strict, safe, and bounded.
+
+On top of PyYAML's ``SafeLoader`` (no Python objects) it refuses, with one line naming the file and the line:
+
+- a key given twice in one mapping (PyYAML would silently keep the last one; ``sim_pos`` and ``"sim_pos"`` are the
+  same key);
+- "billion laughs" alias bombs: at most :data:`~ur3hanoi.io.limits.MAX_ALIASES` aliases, and at most
+  :data:`~ur3hanoi.io.limits.MAX_NODES` nodes with every alias counted as the nodes it expands to; an alias inside
+  its own anchor (a recursive document) is refused too;
+- nesting deeper than :data:`~ur3hanoi.io.limits.MAX_DEPTH` (instead of a ``RecursionError``);
+- integers longer than :data:`~ur3hanoi.io.limits.MAX_INT_DIGITS` digits;
+- anything but UTF-8 text (UTF-16 or Latin-1 files), and files that are not regular or too large
+  (see :mod:`ur3hanoi.io.reading`).
+"""
+
+from __future__ import annotations
+
+import codecs
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+from yaml.constructor import ConstructorError
+from yaml.nodes import MappingNode, Node, ScalarNode
+
+from ur3hanoi.errors import InputError, printable, quote
+from ur3hanoi.io.limits import MAX_ALIASES, MAX_DEPTH, MAX_INT_DIGITS, MAX_NODES
+from ur3hanoi.io.reading import read_input_bytes
+
+_MERGE_TAG = "tag:yaml.org,2002:merge"
+
+
+class YamlLimitError(yaml.MarkedYAMLError):
+    """A document exceeds one of the limits of :mod:`ur3hanoi.io.limits`."""
+
+
+class StrictLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that refuses duplicate keys, alias bombs, deep nesting and huge integers."""
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+        self._nodes = 0
+        self._aliases = 0
+        self._anchored_sizes: dict[int, int] = {}
+
+    def _count(self, n: int, mark: Any) -> None:
+        self._nodes += n
+        if self._nodes > MAX_NODES:
+            raise YamlLimitError(problem=f"more than {MAX_NODES} nodes (aliases counted expanded)",
+                                 problem_mark=mark)
+
+    def compose_node(self, parent: Node | None, index: Any) -> Node | None:
+        event = self.peek_event()
+        if self.check_event(yaml.AliasEvent):
+            self._aliases += 1
+            if self._aliases > MAX_ALIASES:
+                raise YamlLimitError(problem=f"more than {MAX_ALIASES} aliases", problem_mark=event.start_mark)
+            node = super().compose_node(parent, index)
+            size = self._anchored_sizes.get(id(node))
+            if size is None:
+                raise YamlLimitError(problem=f"alias *{printable(event.anchor, 40)} is used inside its own anchor "
+                                             "(a recursive document)", problem_mark=event.start_mark)
+            self._count(size, event.start_mark)
+            return node
+        self._depth += 1
+        if self._depth > MAX_DEPTH:
+            raise YamlLimitError(problem=f"nested deeper than {MAX_DEPTH} levels", problem_mark=event.start_mark)
+        before = self._nodes
+        node = super().compose_node(parent, index)
+        self._depth -= 1
+        self._count(1, event.start_mark)
+        if event.anchor is not None:
+            self._anchored_sizes[id(node)] = self._nodes - before
+        return node
+
+    def construct_mapping(self, node: MappingNode, deep: bool = False) -> dict[Any, Any]:
+        if isinstance(node, MappingNode):
+            first: dict[Any, Any] = {}
+            for key_node, _ in node.value:
+                if key_node.tag == _MERGE_TAG:
+                    continue
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    seen = first.get(key)
+                except TypeError:  # unhashable: the base class reports it
+                    continue
+                if seen is not None:
+                    raise ConstructorError(None, None, f"duplicate key {quote(key)} (first given on line "
+                                                       f"{seen.line + 1})", key_node.start_mark)
+                first[key] = key_node.start_mark
+        return super().construct_mapping(node, deep=deep)
+
+    def construct_yaml_int(self, node: ScalarNode) -> int:
+        text = str(node.value)
+        if sum(c.isalnum() for c in text) > MAX_INT_DIGITS:
+            raise YamlLimitError(problem=f"integer longer than {MAX_INT_DIGITS} digits", problem_mark=node.start_mark)
+        value: int = super().construct_yaml_int(node)
+        return value
+
+
+StrictLoader.add_constructor("tag:yaml.org,2002:int", StrictLoader.construct_yaml_int)
+
+
+@dataclass(frozen=True)
+class YamlFile:
+    """A loaded YAML file: the parsed ``data``, the decoded ``text`` and the sha256 of the file's bytes."""
+
+    data: Any
+    text: str
+    sha256: str
+
+
+def _describe(exc: yaml.YAMLError) -> str:
+    if isinstance(exc, yaml.MarkedYAMLError):
+        problem = printable(": ".join(p for p in (exc.context, exc.problem) if p) or "syntax error", 160)
+        mark = exc.problem_mark or exc.context_mark
+        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark is not None else ""
+        return f"{problem}{where}"
+    return printable(str(exc).splitlines()[0] if str(exc) else type(exc).__name__, 120)
+
+
+def parse_yaml(text: str, source: str, *, what: str = "YAML file", error: type[InputError] = InputError) -> Any:
+    """Parse one YAML document strictly (see the module docstring); ``None`` for an empty document.
+
+    Raises:
+        error: the text is not valid YAML or exceeds a limit; the message names ``source`` and the line.
+    """
+    try:
+        return yaml.load(text, Loader=StrictLoader)  # StrictLoader derives from SafeLoader
+    except YamlLimitError as exc:
+        raise error.file(source, f"refused as a {what}: {_describe(exc)}") from None
+    except yaml.YAMLError as exc:
+        raise error.file(source, f"not valid YAML: {_describe(exc)}") from None
+    except (ValueError, OverflowError, RecursionError) as exc:  # e.g. a timestamp with month 13
+        raise error.file(source, f"not valid YAML: {printable(exc, 120)}") from None
+
+
+def decode_utf8(raw: bytes, source: str, *, what: str = "YAML file", error: type[InputError] = InputError) -> str:
+    """``raw`` as text: UTF-8 (a UTF-8 byte-order mark is allowed), anything else is refused."""
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        raise error.file(source, f"is UTF-16 text: save the {what} as UTF-8")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise error.file(source, f"is not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset {exc.start}): save "
+                                 f"the {what} as UTF-8") from None
+
+
+def load_yaml_file(path: str | Path, *, what: str, error: type[InputError] = InputError,
+                   source: str | None = None, missing_hint: str = "") -> YamlFile:
+    """Read and parse the YAML file ``path`` (see :func:`ur3hanoi.io.reading.read_input_bytes`, :func:`parse_yaml`).
+
+    Args:
+        path: the file.
+        what: its kind, for messages ("calibration file").
+        error: the file kind's exception class.
+        source: how the file is named in messages (default ``str(path)``).
+        missing_hint: appended to the message when the file does not exist.
+    """
+    source = str(path) if source is None else source
+    raw = read_input_bytes(path, what=what, error=error, source=source, missing_hint=missing_hint)
+    text = decode_utf8(raw, source, what=what, error=error)
+    data = parse_yaml(text, source, what=what, error=error)
+    return YamlFile(data=data, text=text, sha256=hashlib.sha256(raw).hexdigest())
