@@ -13,6 +13,7 @@ from pathlib import Path
 
 from ur3hanoi import __version__
 from ur3hanoi.errors import Ur3HanoiError
+from ur3hanoi.ros.cli import add_ros_commands
 
 DEFAULT_CALIBRATION = "lab_sim"
 
@@ -346,7 +347,7 @@ def _run_plan(args: argparse.Namespace) -> int:
 
 # ------------------------------------------------------------------------------------------------------- main
 
-_COMMANDS = [_add_tables, _add_check_table, _add_calibrate, _add_plan, _add_solve]
+_COMMANDS = [_add_tables, _add_check_table, _add_calibrate, _add_plan, _add_solve, add_ros_commands]
 
 
 def build_parser() -> argparse.ArgumentParser:
