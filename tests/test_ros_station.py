@@ -105,3 +105,18 @@ def test_spawn_and_remove_topics_own_roscore_and_reports(tmp_path):
     assert "ur3hanoi/spawn: tower 7 is invalid: expected 1..3" in log
     assert "ur3hanoi/remove_block: block 0 is invalid: expected 1..3" in log
     assert report["reports_written"] == snap["reports_written"] + 1
+
+
+def test_frames_render_in_a_separate_process_and_duration_stops_the_station(tmp_path):
+    env = ros_env(free_port(), tmp_path)
+    env.setdefault("MUJOCO_GL", "egl")
+    frames = tmp_path / "frames"
+    report = tmp_path / "report.json"
+    result = run(ur3hanoi_cmd("ros-station", "--duration", "3", "--frames", str(frames), "--report", str(report)),
+                 env, 120.0)
+    assert result.returncode == 0, result.stderr
+    data = json.loads(report.read_text())
+    assert data["frames"]["rendered"] >= 1
+    assert len(list(frames.glob("frame_*.png"))) == data["frames"]["rendered"]
+    assert data["control"]["cycles"] >= 0.5 * 3.0 * 125  # the loop ran (timing itself: bench/bench_ros.py)
+    assert "ros-station stopped: 0 commands executed, 0 refused" in result.stdout

@@ -30,6 +30,7 @@ class ExecutedMove:
     lead_velocity: float  # [rad/s] peak speed of the fastest joint (after the caps)
     lead_acceleration: float  # [rad/s^2]
     settle_s: float | None = None  # from the profile's end to the first period within tolerance (None: not yet)
+    rest_s: float = 0.0  # how long the arm then rested within tolerance before the next command (or now)
     rest_error_rad: float | None = None  # error when the next command started (or now)
     rest_max_error_rad: float | None = None  # largest error at rest after settling
 
@@ -39,7 +40,8 @@ class ExecutedMove:
 
         return {**self.command.as_dict(), "t_start": round(self.t_start, 4), "duration_s": round(self.duration_s, 4),
                 "lead_velocity": round(self.lead_velocity, 4), "lead_acceleration": round(self.lead_acceleration, 4),
-                "settle_s": r(self.settle_s, 4), "rest_error_rad": r(self.rest_error_rad, 9),
+                "settle_s": r(self.settle_s, 4), "rest_s": round(self.rest_s, 4),
+                "rest_error_rad": r(self.rest_error_rad, 9),
                 "rest_max_error_rad": r(self.rest_max_error_rad, 9)}
 
 
@@ -60,11 +62,13 @@ class StationDriver:
     Args:
         world: the simulated station.
         max_queue: commands waiting beyond this many are refused (a runaway publisher must not queue minutes).
+        min_rest_s: the summary's rest error counts only rests at least this long [s].
     """
 
-    def __init__(self, world: StationWorld, max_queue: int = 100) -> None:
+    def __init__(self, world: StationWorld, max_queue: int = 100, min_rest_s: float = 0.2) -> None:
         self.world = world
         self.max_queue = max_queue
+        self.min_rest_s = min_rest_s
         self.queue: deque[MoveCommand] = deque()
         self.executed: list[ExecutedMove] = []
         self.rejected: list[Rejection] = []
@@ -120,12 +124,15 @@ class StationDriver:
                 cur.settle_s = max(0.0, w.time - self._profile_end)
             if cur.settle_s is not None:
                 cur.rest_max_error_rad = max(err, cur.rest_max_error_rad or 0.0)
+                cur.rest_s = w.time - self._profile_end - cur.settle_s
 
     def summary(self) -> dict[str, Any]:
         """Counts and the worst settle figures of the executed commands."""
         self._close_rest()
         settles = [m.settle_s for m in self.executed if m.settle_s is not None]
-        rests = [m.rest_error_rad for m in self.executed if m.rest_error_rad is not None]
+        # At rest: the arm stayed at least min_rest_s (clients that move on at once never let it rest).
+        rests = [m.rest_error_rad for m in self.executed
+                 if m.rest_error_rad is not None and m.rest_s >= self.min_rest_s]
         drifts = [m.rest_max_error_rad for m in self.executed if m.rest_max_error_rad is not None]
         return {
             "executed": len(self.executed),

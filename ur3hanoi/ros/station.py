@@ -18,6 +18,9 @@ the following ones, so world time never drifts from wall time). The worst lag of
 schedule is reported. A roscore is started when none answers at ``ROS_MASTER_URI`` (:mod:`ur3hanoi.ros.master`)
 and stopped on exit.
 
+``--frames``/``--video`` render in a separate low-priority process (:mod:`ur3hanoi.ros.render`), which drops
+frames rather than stall the loop.
+
 The JSON report (:meth:`RosStation.report`): commands executed (with duration, settle time and rest error),
 refused, suction events, faults, final block positions (tower/height, or none = off-grid), loop timing. It is
 written on SIGINT/SIGTERM and at the end of ``--duration``, and on SIGUSR1 without stopping: to ``--report FILE``
@@ -26,6 +29,8 @@ written on SIGINT/SIGTERM and at the end of ``--duration``, and on SIGUSR1 witho
 
 from __future__ import annotations
 
+import bisect
+import gc
 import json
 import math
 import os
@@ -77,8 +82,12 @@ class StationOptions:
     master_uri: str | None = None
 
 
+LAG_BINS_MS: tuple[float, ...] = (1.0, 2.0, 4.0, 8.0, 16.0, 32.0)
+"""Upper edges [ms] of the loop-lag histogram in the report (a last bin counts the rest)."""
+
+
 class LoopTiming:
-    """Lag of each control cycle's start behind its wall-clock schedule [s]."""
+    """Lag of each control cycle's start behind its wall-clock schedule [s], and a histogram of it."""
 
     def __init__(self, period_s: float) -> None:
         self.period_s = period_s
@@ -86,6 +95,7 @@ class LoopTiming:
         self.worst_lag_s = 0.0
         self.total_lag_s = 0.0
         self.late_cycles = 0  # started more than one period late
+        self.histogram = [0] * (len(LAG_BINS_MS) + 1)
 
     def add(self, lag_s: float) -> None:
         self.cycles += 1
@@ -93,13 +103,16 @@ class LoopTiming:
         self.worst_lag_s = max(self.worst_lag_s, lag_s)
         if lag_s > self.period_s:
             self.late_cycles += 1
+        self.histogram[bisect.bisect_right(LAG_BINS_MS, 1e3 * lag_s)] += 1
 
     def as_dict(self, wall_s: float) -> dict[str, Any]:
         return {"rate_hz": round(1.0 / self.period_s, 3), "period_s": self.period_s, "cycles": self.cycles,
                 "publish_rate_hz": round(self.cycles / wall_s, 2) if wall_s > 0 else None,
                 "worst_lag_s": round(self.worst_lag_s, 6),
                 "mean_lag_s": round(self.total_lag_s / self.cycles, 6) if self.cycles else None,
-                "late_cycles": self.late_cycles}
+                "late_cycles": self.late_cycles,
+                "lag_histogram_ms": {**{f"<{b:g}": n for b, n in zip(LAG_BINS_MS, self.histogram, strict=False)},
+                                     f">={LAG_BINS_MS[-1]:g}": self.histogram[-1]}}
 
 
 class RosStation:
@@ -138,7 +151,10 @@ class RosStation:
         self._stop = False
         self._dump = False
         self._wall0 = 0.0
+        self._wall_end: float | None = None
         self._rospy: Any = None
+        self._sink: Any = None
+        self._frames: dict[str, int] | None = None
 
     # ---------------------------------------------------------------------------------------------- callbacks
     def _on_command(self, msg: Any) -> None:
@@ -190,7 +206,7 @@ class RosStation:
         w, st = self.world, self.station
         suction_kinds = {"suction_on", "suction_off", "grasp", "release"}
         events = [e.as_dict() for e in w.events]
-        wall = time.perf_counter() - self._wall0 if self._wall0 else 0.0
+        wall = (self._wall_end or time.perf_counter()) - self._wall0 if self._wall0 else 0.0
         holding = w.holding
         return {
             "station": {"name": st.name, "calibration": st.source, "sha256": st.sha256},
@@ -215,6 +231,8 @@ class RosStation:
                 "at_home": w.at_home(),
                 "blocks": [b.as_dict() for b in w.blocks()],
             },
+            "frames": self._frames if self._frames is not None else (
+                None if self._sink is None else {"rendered": self._sink.rendered, "dropped": self._sink.dropped}),
             "reports_written": self.reports_written + 1,
         }
 
@@ -245,6 +263,7 @@ class RosStation:
         previous = {s: signal.signal(s, self._signal) for s in handled}
         sink: Any = None
         try:
+            sink = self._sink = self._open_sink()  # before rospy starts its threads
             with RosCore(self.master_uri) as core:
                 self.roscore_started = core.started
                 os.environ["ROS_MASTER_URI"] = self.master_uri  # rospy reads it from the environment
@@ -254,11 +273,13 @@ class RosStation:
                 rospy.Subscriber("/ur3/command", msgs.command, self._on_command, queue_size=100)
                 rospy.Subscriber("/ur3hanoi/spawn", std_msgs.Int32, self._on_spawn, queue_size=10)
                 rospy.Subscriber("/ur3hanoi/remove_block", std_msgs.Int32, self._on_remove, queue_size=10)
-                sink = self._open_sink()
                 try:
                     self._loop(msgs, pub_pos, pub_grip, sink)
                 finally:
+                    self._wall_end = time.perf_counter()
                     rospy.signal_shutdown("ur3hanoi ros-station stopped")
+                if sink is not None:
+                    self._frames = sink.close()
                 report = self.write_report()
         finally:
             if sink is not None:
@@ -271,9 +292,9 @@ class RosStation:
         opts = self.options
         if opts.frames is None and opts.video is None:
             return None
-        from ur3hanoi.sim import OffscreenRecorder
+        from ur3hanoi.ros.render import FrameProcess
 
-        return OffscreenRecorder(self.station, self.world.scene.model, frames_dir=opts.frames, video=opts.video)
+        return FrameProcess(opts.calibration, self.world.n_blocks, opts.frames, opts.video)
 
     def _loop(self, msgs: Any, pub_pos: Any, pub_grip: Any, sink: Any) -> None:
         w, opts = self.world, self.options
@@ -283,6 +304,9 @@ class RosStation:
         st = self.station
         self.out(f"{READY_LINE} on {self.master_uri}: {st.name}, {w.n_blocks} blocks on tower {opts.start + 1}, "
                  f"{1.0 / period:g} Hz (pid {os.getpid()})")
+        # Everything built so far lives as long as the node: keep the cyclic collector from scanning it in the loop.
+        gc.collect()
+        gc.freeze()
         self._wall0 = next_t = time.perf_counter()
         while not self._stop and not self._rospy.is_shutdown():
             now = time.perf_counter()
@@ -293,7 +317,7 @@ class RosStation:
             pub_pos.publish(msgs.position(position=[float(x) for x in w.q], isReady=self.driver.ready))
             pub_grip.publish(msgs.gripper_input(DIGIN=fb.digin, AIN0=fb.ain0, AIN1=0.0))
             if sink is not None and w.time + 1e-9 >= next_frame:
-                sink(w.scene.model, w.scene.data)
+                sink.offer(w.scene.data.qpos)
                 next_frame += frame_dt
             if self._dump:
                 self._dump = False
