@@ -1,6 +1,6 @@
 # Two commands do all the set-up on a fresh machine:
 #   make solve   -> creates .venv from requirements.lock on first use, runs the main job (headless MuJoCo solve)
-#   make test    -> same venv, runs the test suite (notebooks included)
+#   make test    -> same venv, runs the test suite (notebooks included; ROS tests in real time, about 3 min)
 PY ?= python3
 VENV ?= .venv
 STAMP := $(VENV)/.installed
@@ -8,7 +8,7 @@ export MUJOCO_GL ?= egl
 
 .PHONY: solve test venv lint bench tables docs clean
 
-$(STAMP): pyproject.toml requirements.lock
+$(STAMP): pyproject.toml requirements.lock tools/ensure-system-deps.sh
 	bash tools/ensure-system-deps.sh
 	$(PY) -m venv $(VENV)
 	$(VENV)/bin/pip install -q --upgrade pip

@@ -26,18 +26,27 @@ class SimArm:
         self.io = False
         self.dest = self.world.q
         self.calls: list[str] = []
+        self.watched_moves = 0
+        self.drop_on_watched_move: int | None = None  # remove the held block 0.1 s into this watched move
+
+    def _cycle(self, watched: bool, cycles: int) -> None:
+        if watched and self.watched_moves == self.drop_on_watched_move and cycles == 12:
+            assert self.world.holding is not None
+            assert self.world.remove(self.world.holding) == "dropped"
+        self.driver.cycle()
 
     def move(self, q, watch: Callable[[], None] | None = None) -> None:
         self.calls.append("move")
         self.driver.submit(list(q), self.v, self.a, self.io)
         self.dest = np.array(q, dtype=float)
+        self.watched_moves += watch is not None
         self.driver.cycle()
-        for _ in range(2000):
+        for cycles in range(2000):
             if watch is not None:
                 watch()
             if np.max(np.abs(self.world.q - self.dest)) < 5e-4:
                 return
-            self.driver.cycle()
+            self._cycle(watch is not None, cycles)
         raise AssertionError(f"never reached {q}")
 
     def suction(self, on: bool) -> None:
@@ -102,6 +111,17 @@ def test_block_dropped_during_the_carry_halts(lab_sim):
         run_lab_solve(arm, generate_table(lab_sim).q, lab_sim.q_home_array, 0, 2, 3)
     assert world.at_home() and not world.suction_on and world.holding is None
     assert [e.kind for e in world.events].count("dropped") == 1
+
+
+@pytest.mark.parametrize(("leg", "what"), [(1, "lift"), (2, "carry"), (3, "descent")])
+def test_block_lost_in_any_leg_with_a_block_halts(lab_sim, leg, what):
+    world = StationWorld(lab_sim, 0, 3)
+    arm = SimArm(StationDriver(world))
+    arm.drop_on_watched_move = 3 + leg  # move 2 (its watched moves are 4, 5, 6)
+    with pytest.raises(SuctionFaultError, match="suction fault in move 2/7: yellow block 2 was dropped while "
+                                                "carrying it from tower 1 to tower 2"):
+        run_lab_solve(arm, generate_table(lab_sim).q, lab_sim.q_home_array, 0, 2, 3)
+    assert world.at_home() and not world.suction_on, what
 
 
 def test_bad_table_shape_is_refused(lab_sim):

@@ -1,8 +1,9 @@
 """The ROS master: parse ``ROS_MASTER_URI``, ask whether a master answers, start and stop a ``roscore``.
 
 :class:`RosCore` is a context manager: when no master answers at the URI (and the URI names this machine) it
-starts ``roscore -p PORT`` in its own session and stops it on exit (SIGINT, the way roscore wants to be stopped;
-SIGKILL of it and its children only if it does not exit within the timeout). A master that already answers is
+starts ``roscore -p PORT`` in its own session, waits until its ``rosout`` node is registered too, and stops it on
+exit (SIGINT, the way roscore wants to be stopped; SIGKILL of it and its children only if it does not exit within
+the timeout). A master that already answers is
 used and left running.
 """
 
@@ -87,6 +88,16 @@ def master_pid(uri: str, timeout: float = 1.0) -> int | None:
     return int(pid) if code == 1 else None
 
 
+def node_registered(uri: str, node: str, timeout: float = 1.0) -> bool:
+    """True when the master at ``uri`` knows ``node`` (e.g. ``/rosout``), within ``timeout`` [s]."""
+    proxy = xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(timeout))
+    try:
+        reply: Any = proxy.lookupNode("/ur3hanoi_probe", node)
+        return bool(reply[0] == 1)
+    except (OSError, xmlrpc.client.Error, ValueError, TypeError, IndexError):
+        return False
+
+
 def master_answers(uri: str, timeout: float = 1.0) -> bool:
     """True when a ROS master answers at ``uri`` within ``timeout`` [s]."""
     return master_pid(uri, timeout) is not None
@@ -140,7 +151,8 @@ class RosCore:
         self.started = True
         deadline = time.monotonic() + self.start_timeout
         while time.monotonic() < deadline:
-            if master_answers(self.uri, timeout=0.5):
+            # Up when rosout has registered too: roscore ignores a SIGINT that arrives while it still launches it.
+            if node_registered(self.uri, "/rosout", timeout=0.5):
                 return self
             if self._proc.poll() is not None:
                 break
@@ -161,9 +173,15 @@ class RosCore:
         proc, self._proc = self._proc, None
         if proc is not None and proc.poll() is None:
             children = _children(proc.pid)
-            proc.send_signal(signal.SIGINT)
             try:
-                proc.wait(timeout=self.stop_timeout)
+                # A second SIGINT covers one that roscore missed while it was busy launching its nodes.
+                for wait_s in (min(5.0, self.stop_timeout), self.stop_timeout):
+                    proc.send_signal(signal.SIGINT)
+                    with contextlib.suppress(subprocess.TimeoutExpired):
+                        proc.wait(timeout=wait_s)
+                        break
+                else:
+                    raise subprocess.TimeoutExpired(proc.args, self.stop_timeout)
             except subprocess.TimeoutExpired:
                 for pid in [*_children(proc.pid), *children]:
                     with contextlib.suppress(ProcessLookupError):
