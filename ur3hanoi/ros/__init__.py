@@ -10,6 +10,7 @@ Modules, one concept each (importing this package needs neither rospy nor MuJoCo
 - :mod:`~ur3hanoi.ros.world`: the MuJoCo station stepped one control period at a time (servo, suction, blocks).
 - :mod:`~ur3hanoi.ros.driver`: the command FIFO, ``isReady`` and the settle measurements.
 - :mod:`~ur3hanoi.ros.station`: the ``ros-station`` node (real-time loop, topics, report).
+- :mod:`~ur3hanoi.ros.render`: ``--frames``/``--video`` in a separate low-priority process.
 - :mod:`~ur3hanoi.ros.client`: a rospy client of the course's topics (:class:`~ur3hanoi.ros.client.RosArm`).
 - :mod:`~ur3hanoi.ros.solve`: the lab program's solve with suction checks and halt (:func:`run_lab_solve`).
 - :mod:`~ur3hanoi.ros.cli`: the subcommands ``ros-station``, ``ros-solve``, ``ros-env``.
