@@ -1,6 +1,6 @@
 # Two commands do all the set-up on a fresh machine:
 #   make solve   -> creates .venv from requirements.lock on first use, runs the main job (headless MuJoCo solve)
-#   make test    -> same venv, runs the test suite (notebooks included)
+#   make test    -> same venv, runs the test suite (notebooks included; ROS tests in real time, about 3 min)
 PY ?= python3
 VENV ?= .venv
 STAMP := $(VENV)/.installed
@@ -8,7 +8,7 @@ export MUJOCO_GL ?= egl
 
 .PHONY: solve test venv lint bench tables docs clean
 
-$(STAMP): pyproject.toml requirements.lock
+$(STAMP): pyproject.toml requirements.lock tools/ensure-system-deps.sh
 	@$(PY) -c 'import sys; ok = (3, 11) <= sys.version_info[:2] <= (3, 13); ok or print(f"ur3hanoi: error: Python {sys.version.split()[0]} ($(PY)) is not supported: use Python 3.11, 3.12 or 3.13, e.g. make PY=python3.12"); sys.exit(not ok)'
 	bash tools/ensure-system-deps.sh
 	$(PY) -m venv $(VENV)

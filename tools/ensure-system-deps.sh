@@ -1,16 +1,22 @@
 #!/usr/bin/env bash
-# Headless MuJoCo rendering (MUJOCO_GL=egl: --video/--frames and the notebooks) needs Mesa's EGL and GL drivers.
-# Installs them with apt-get when missing and we are root; otherwise says what to install. Python packages are
-# not installed here (see requirements.lock).
+# System packages the project needs outside its virtual environment, installed with apt-get when missing and we
+# are root; otherwise says what to install. Python packages from PyPI are not installed here (requirements.lock).
+#  - Headless MuJoCo rendering (MUJOCO_GL=egl: --video/--frames and the notebooks): Mesa's EGL and GL drivers.
+#  - ROS 1 for `ur3hanoi ros-station` / `ros-solve` and their tests: Debian's roscore and pure-Python rospy,
+#    genpy and std_msgs (about 40 s). ur3hanoi.ros appends /usr/lib/python3/dist-packages to the venv's path.
 set -euo pipefail
 missing=()
 ldconfig -p | grep -q 'libEGL.so.1 ' || missing+=(libegl1)
 ldconfig -p | grep -q 'libEGL_mesa.so.0 ' || missing+=(libegl-mesa0)
 [ -e /usr/lib/x86_64-linux-gnu/dri ] || [ -e /usr/lib/aarch64-linux-gnu/dri ] || missing+=(libgl1-mesa-dri)
+command -v roscore >/dev/null || missing+=(ros-core)
+for pkg in rospy genpy std_msgs; do
+  [ -e "/usr/lib/python3/dist-packages/$pkg/__init__.py" ] || missing+=("python3-${pkg//_/-}")
+done
 [ ${#missing[@]} -eq 0 ] && exit 0
 if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
-  echo "installing headless rendering libraries: ${missing[*]}" >&2
+  echo "installing system packages: ${missing[*]}" >&2
   apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
 else
-  echo "warning: headless rendering needs: ${missing[*]} (e.g. sudo apt-get install ${missing[*]})" >&2
+  echo "warning: missing system packages: ${missing[*]} (e.g. sudo apt-get install ${missing[*]})" >&2
 fi

@@ -15,10 +15,10 @@ from collections.abc import Sequence
 from typing import NoReturn
 
 from ur3hanoi import __version__
-from ur3hanoi.cli import calibrate, check_table, exit_codes, plan, solve, tables
+from ur3hanoi.cli import calibrate, check_table, exit_codes, plan, ros, solve, tables
 from ur3hanoi.errors import Ur3HanoiError, printable
 
-_COMMANDS = (tables, check_table, calibrate, plan, solve)
+_COMMANDS = (tables, check_table, calibrate, plan, solve, ros)
 _DEBUG_HELP = "on an internal error, show the Python traceback (for a bug report)"
 
 
@@ -34,7 +34,7 @@ def _one_line(text: object) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The ``ur3hanoi`` parser with its five commands."""
+    """The ``ur3hanoi`` parser with its commands."""
     parser = _Parser(prog="ur3hanoi", description="UR3 Tower of Hanoi lab toolkit.")
     parser.add_argument("--version", action="version", version=f"ur3hanoi {__version__}")
     parser.add_argument("--debug", action="store_true", help=_DEBUG_HELP)

@@ -38,6 +38,13 @@ TOWER = Number(1, MAX_TOWERS, integer=True, what="a tower number (1-based)")
 BLOCKS = Number(1, MAX_BLOCKS, integer=True, what="a number of blocks")
 HEIGHT = Number(1, MAX_HEIGHTS, integer=True, what="a height (1-based)")
 MOVE = Number(1, 2**MAX_BLOCKS - 1, integer=True, what="a move number (1-based)")
+# ROS commands (ros-station, ros-solve).
+ROS_RATE = Number(50.0, 500.0, unit="Hz", what="a control and publishing rate")
+CMD_SPEED = Number(0.0, 10.0, lo_open=True, unit="rad/s", what="a commanded joint speed (the driver caps it)")
+CMD_ACCELERATION = Number(0.0, 20.0, lo_open=True, unit="rad/s^2",
+                          what="a commanded joint acceleration (the driver caps it)")
+GRASP_TIMEOUT = Number(0.0, 10.0, lo_open=True, unit="s", what="a wait for the vacuum switch")
+DURATION = Number(0.0, 7 * 86400.0, lo_open=True, unit="s", what="a run time")
 
 _MAX_TEXT = 40  # longer option values are not numbers anyone means (and int() of 5000 digits is refused anyway)
 

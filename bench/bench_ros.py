@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""Benchmark the ROS bridge in real time: a full 3-block solve through ur3/command against `ur3hanoi ros-station`.
+
+Usage: .venv/bin/python bench/bench_ros.py [--v V] [--a A]
+Measures, each against a fresh station (own roscore on a free port, tower 1 -> 3):
+- `ur3hanoi ros-solve` wall time (the client's own figure: first command to home),
+- the lab-style client tests/lab2_exec_starter.py (written like the course's lab2_exec.py: 20 Hz polling, 1 s sleep
+  after every grasp) wall time, run with `ur3hanoi ros-env`'s environment,
+- the station's control loop: worst and mean lag of a cycle's start behind its wall-clock schedule, cycles more than
+  one period late, publishing rate; and how the arm settled (worst time from a profile's end to within 0.0005 rad,
+  worst error at rest).
+Needs Debian's ROS 1 (tools/ensure-system-deps.sh). ROS runs on the wall clock: about 2 minutes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shlex
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from ur3hanoi.ros.master import RosCore  # noqa: E402
+
+TIMEOUT_S = 300.0
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def cli(*args: str) -> list[str]:
+    return [sys.executable, "-m", "ur3hanoi.cli", *args]
+
+
+def run_against_station(tmp: Path, client: list[str], stdin: str | None = None) -> tuple[float, dict[str, Any]]:
+    """Start roscore + ros-station, run ``client`` to completion; returns (client wall time [s], station report)."""
+    port = free_port()
+    env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{port}", ROS_HOME=str(tmp / "ros_home"),
+               ROS_IP="127.0.0.1", PYTHONUNBUFFERED="1")
+    os.environ.update(ROS_HOME=env["ROS_HOME"], ROS_IP="127.0.0.1")
+    report = tmp / f"report-{port}.json"
+    with RosCore(env["ROS_MASTER_URI"]):
+        station = subprocess.Popen(cli("ros-station", "--report", str(report)), env=env, text=True,
+                                   stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, start_new_session=True)
+        try:
+            assert station.stdout is not None
+            line = station.stdout.readline()
+            assert line.startswith("ur3hanoi ros-station: ready"), line
+            t0 = time.perf_counter()
+            result = subprocess.run(client, env=env, input=stdin, text=True, capture_output=True, timeout=TIMEOUT_S)
+            wall = time.perf_counter() - t0
+            assert result.returncode == 0, result.stdout + result.stderr
+            station.send_signal(signal.SIGINT)
+            station.wait(timeout=30)
+        finally:
+            if station.poll() is None:
+                os.killpg(station.pid, signal.SIGKILL)
+                station.wait()
+    data = json.loads(report.read_text())
+    slots = {b["block"]: (b["tower"], b["height"]) for b in data["final"]["blocks"]}
+    assert slots == {1: (3, 1), 2: (3, 2), 3: (3, 3)}, slots
+    return wall, data
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--v", default="4.0", help="ros-solve joint speed [rad/s] (default 4.0, the lab's)")
+    ap.add_argument("--a", default="4.0", help="ros-solve joint acceleration [rad/s^2] (default 4.0, the lab's)")
+    args = ap.parse_args()
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="bench_ros-") as name:
+        tmp = Path(name)
+        (tmp / "ros_home").mkdir()
+        wall, rep = run_against_station(tmp, cli("ros-solve", "--start", "1", "--end", "3", "--v", args.v,
+                                                 "--a", args.a))
+        rows.append((f"ur3hanoi ros-solve (v={args.v}, a={args.a})", wall, rep))
+        table = tmp / "lab2_data.yaml"
+        subprocess.run(cli("tables", "lab_sim", "--key", "sim_pos", "-o", str(table)), check=True,
+                       capture_output=True)
+        env_cmd = shlex.join(cli("ros-env", "--dir", str(tmp / "ros-env")))
+        program = shlex.join([sys.executable, str(REPO / "tests" / "lab2_exec_starter.py"), "--yaml", str(table)])
+        wall, rep = run_against_station(tmp, ["bash", "-c", f'eval "$({env_cmd})" 2>/dev/null && exec {program}'],
+                                        stdin="1\n3\n")
+        rows.append(("lab-style lab2_exec_starter.py (v=a=4, 1 s grasp sleep)", wall, rep))
+    print("3 blocks, tower 1 -> 3, lab_sim, against ur3hanoi ros-station (125 Hz), wall clock")
+    print(f"{'client':<58} {'wall [s]':>8} {'cmds':>5} {'worst lag [ms]':>14} {'mean lag [ms]':>13} "
+          f"{'late':>5} {'pub [Hz]':>8} {'settle [ms]':>11} {'rest err [rad]':>14}")
+    for label, wall, rep in rows:
+        c, ctl = rep["commands"], rep["control"]
+        print(f"{label:<58} {wall:>8.1f} {c['executed']:>5} {1e3 * ctl['worst_lag_s']:>14.2f} "
+              f"{1e3 * ctl['mean_lag_s']:>13.3f} {ctl['late_cycles']:>5} {ctl['publish_rate_hz']:>8.1f} "
+              f"{1e3 * c['max_settle_s']:>11.0f} {c['max_rest_error_rad']:>14.2e}")
+    for label, _wall, rep in rows:
+        print(f"loop lag histogram [ms], {label.split(' (')[0]}: {rep['control']['lag_histogram_ms']}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

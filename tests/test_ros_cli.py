@@ -1,0 +1,60 @@
+"""The ROS subcommands' argument handling: one-line errors, exit code 2, before any motion (no ROS master used)."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.ros_support import free_port
+from ur3hanoi.cli import main
+from ur3hanoi.cli.solve import prompt_tower
+
+
+def error_line(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    return err[0]
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["ros-solve", "--start", "1"], "--start and --end are required when stdin is not a terminal (towers 1..3)"),
+    (["ros-solve", "--start", "1", "--end", "3", "--key", "real_pos"], "--key is only used with --table"),
+    (["ros-solve", "--start", "2", "--end", "2"], "start and end tower are both 2"),
+    (["ros-solve", "--start", "1", "--end", "4"], "end tower 4 is outside the grid: expected 1..3"),
+    (["ros-solve", "--start", "1", "--end", "3", "--blocks", "4"], "4 blocks is invalid: expected 1..3"),
+    (["ros-station", "--start", "4"], "start tower 4 is invalid: expected 1..3"),
+    (["ros-station", "--remove-block", "5"], "removed block height 5 is invalid: expected 1..3"),
+    (["ros-station", "--master", "localhost:11311"], "ROS master URI 'localhost:11311' is invalid"),
+    (["ros-env", "--master", "http://localhost"], "ROS master URI 'http://localhost' is invalid"),
+])
+def test_bad_arguments_exit_2_with_one_line(argv, message, capsys, monkeypatch):
+    monkeypatch.setattr("sys.stdin.isatty", lambda: False)
+    assert main(argv) == 2
+    line = error_line(capsys)
+    assert line.startswith("ur3hanoi: error: ") and message in line
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["ros-station", "--rate", "30"], "argument --rate: '30' is invalid: expected a control and publishing rate [Hz] "
+                                      "in [50, 500]"),
+    (["ros-solve", "--v", "0"], "argument --v: '0' is invalid"),
+    (["ros-solve", "--grasp-timeout", "nan"], "argument --grasp-timeout: 'nan' is invalid"),
+])
+def test_bad_option_values_exit_2_with_one_line(argv, message, capsys):
+    assert main(argv) == 2
+    line = error_line(capsys)
+    assert line.startswith(f"ur3hanoi {argv[0]}: error: ") and message in line, line
+
+
+def test_ros_solve_without_a_master_exits_2(capsys):
+    uri = f"http://127.0.0.1:{free_port()}"
+    assert main(["ros-solve", "--start", "1", "--end", "3", "--master", uri]) == 2
+    assert f"ur3hanoi: error: no ROS master answers at {uri}: start `ur3hanoi ros-station`" in error_line(capsys)
+
+
+def test_prompt_repeats_like_the_lab_program(monkeypatch, capsys):
+    answers = iter(["4", "x", "1", "3"])
+    monkeypatch.setattr("builtins.input", lambda prompt: print(prompt, end="") or next(answers))
+    assert prompt_tower("end", 3, exclude=0) == 2
+    out = capsys.readouterr().out
+    assert out.count("Enter the end tower <2 or 3> ") == 4
+    assert out.count("Please just enter the character 2 or 3") == 3

@@ -1,0 +1,122 @@
+"""``ur3hanoi ros-station`` over a real roscore (marked ``ros``, real time): the lab's own kind of program solves
+against it, malformed commands are refused without motion, the spawn/remove topics, its own roscore, reports."""
+
+from __future__ import annotations
+
+import json
+import math
+import shlex
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.ros_support import (
+    final_slots,
+    free_port,
+    requires_ros,
+    ros_env,
+    roscore,
+    run,
+    station,
+    ur3hanoi_cmd,
+)
+from ur3hanoi.ros.master import master_answers
+from ur3hanoi.station import load_station
+
+pytestmark = [pytest.mark.ros, requires_ros]
+
+TESTS = Path(__file__).resolve().parent
+HOME = [round(x, 12) for x in load_station("lab_sim").q_home]
+
+
+def publish(env: dict[str, str], items: list[list[object]]) -> None:
+    result = run([sys.executable, str(TESTS / "ros_publisher.py"), json.dumps(items)], env, 60.0)
+    assert result.returncode == 0, result.stderr
+
+
+def test_lab_style_program_solves_against_the_station(tmp_path):
+    """tests/lab2_exec_starter.py: written like the course's lab2_exec.py, run with `ur3hanoi ros-env`'s exports."""
+    env = ros_env(free_port(), tmp_path)
+    table = tmp_path / "lab2_data.yaml"
+    assert run(ur3hanoi_cmd("tables", "lab_sim", "--key", "sim_pos", "-o", str(table)), env, 120).returncode == 0
+    ros_env_cmd = shlex.join(ur3hanoi_cmd("ros-env", "--dir", str(tmp_path / "ros-env")))
+    program = shlex.join([sys.executable, str(TESTS / "lab2_exec_starter.py"), "--simulator", "True", "--yaml",
+                          str(table)])
+    with roscore(env), station(env, tmp_path) as st:
+        result = run(["bash", "-c", f'eval "$({ros_env_cmd})" && exec {program}'], env, 240.0, stdin="1\n3\n")
+        assert result.returncode == 0, result.stdout + result.stderr
+        assert "Enter the start tower <1 2 or 3> " in result.stdout
+        report = st.stop()
+    assert final_slots(report) == {1: (3, 1), 2: (3, 2), 3: (3, 3)}
+    assert report["final"]["at_home"] and not report["final"]["suction_on"]
+    assert report["commands"]["rejected"] == 0
+    assert [e["kind"] for e in report["suction_events"]].count("grasp") == 7
+    # The lab's move_arm returned after every move: the arm always came within its 0.0005 rad.
+    assert report["commands"]["max_error_after_settling_rad"] <= 5e-4
+
+
+def test_malformed_commands_are_refused_with_a_logged_error_and_no_motion(tmp_path):
+    env = ros_env(free_port(), tmp_path)
+    cmd = "/ur3/command"
+    bad = [
+        [cmd, "command", {"destination": HOME[:5], "v": 1.0, "a": 1.0, "io_0": True}],
+        [cmd, "command", {"destination": [*HOME[:2], math.nan, *HOME[3:]], "v": 1.0, "a": 1.0, "io_0": True}],
+        [cmd, "command", {"destination": [7.0, *HOME[1:]], "v": 1.0, "a": 1.0, "io_0": True}],
+        [cmd, "command", {"destination": HOME, "v": 0.0, "a": 1.0, "io_0": True}],
+        [cmd, "String", {"data": "movej([0, 0, 0, 0, 0, 0])"}],  # unknown message type: never connected
+    ]
+    with roscore(env), station(env, tmp_path) as st:
+        publish(env, bad)
+        report = st.stop()
+    reasons = [r["reason"] for r in report["rejected"]]
+    assert reasons == [
+        "destination has 5 values: expected 6 joint angles [rad]",
+        "destination[2] = nan is invalid: expected a finite angle [rad]",
+        "destination[0] = 7.0 rad is outside joint 1's limits: expected -6.28319 <= q <= 6.28319 rad",
+        "v = 0.0 is invalid: expected a finite number > 0 [rad/s]",
+    ]
+    log = st.log()
+    for reason in reasons:
+        assert f"ur3/command rejected, the arm does not move: {reason}" in log
+    assert report["executed"] == [] and report["suction_events"] == []
+    assert max(abs(a - b) for a, b in zip(report["final"]["q"], HOME, strict=True)) < 1e-6
+    assert report["final"]["ready"] and not report["final"]["suction_on"]
+
+
+def test_spawn_and_remove_topics_own_roscore_and_reports(tmp_path):
+    env = ros_env(free_port(), tmp_path)
+    uri = env["ROS_MASTER_URI"]
+    with station(env, tmp_path, "--start", "2", "--blocks", "3") as st:
+        assert master_answers(uri)
+        snap = st.snapshot()
+        assert snap["roscore_started"] and snap["start_tower"] == 2
+        assert final_slots(snap) == {1: (2, 1), 2: (2, 2), 3: (2, 3)}
+        control = snap["control"]
+        assert control["publish_rate_hz"] > 50.0 and control["rate_hz"] == 125.0
+        publish(env, [["/ur3hanoi/spawn", "Int32", {"data": 3}], ["/ur3hanoi/remove_block", "Int32", {"data": 1}],
+                      ["/ur3hanoi/spawn", "Int32", {"data": 7}], ["/ur3hanoi/remove_block", "Int32", {"data": 0}]])
+        report = st.stop()
+    assert not master_answers(uri), "the station must stop the roscore it started"
+    assert final_slots(report) == {1: (None, None), 2: (3, 2), 3: (3, 3)}
+    assert report["faults"] == [{"t": report["faults"][0]["t"], "kind": "removed", "block": 1, "colour": "green"}]
+    assert [s["tower"] for s in report["spawns"]] == [2, 3]
+    log = st.log()
+    assert "ur3hanoi/spawn: tower 7 is invalid: expected 1..3" in log
+    assert "ur3hanoi/remove_block: block 0 is invalid: expected 1..3" in log
+    assert report["reports_written"] == snap["reports_written"] + 1
+
+
+def test_frames_render_in_a_separate_process_and_duration_stops_the_station(tmp_path):
+    env = ros_env(free_port(), tmp_path)
+    env.setdefault("MUJOCO_GL", "egl")
+    frames = tmp_path / "frames"
+    report = tmp_path / "report.json"
+    result = run(ur3hanoi_cmd("ros-station", "--duration", "3", "--frames", str(frames), "--report", str(report)),
+                 env, 120.0)
+    assert result.returncode == 0, result.stderr
+    data = json.loads(report.read_text())
+    assert data["frames"]["rendered"] >= 1
+    assert len(list(frames.glob("frame_*.png"))) == data["frames"]["rendered"]
+    assert data["control"]["cycles"] >= 0.5 * 3.0 * 125  # the loop ran (timing itself: bench/bench_ros.py)
+    assert "ros-station stopped: 0 commands executed, 0 refused" in result.stdout

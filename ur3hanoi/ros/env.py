@@ -1,0 +1,134 @@
+"""Find ROS 1 (Debian's packages) from the project's Python, and the environment a lab program needs.
+
+Debian 12 ships ROS 1 as ordinary packages: ``ros-core`` (``roscore``) and the pure-Python ``python3-rospy``,
+``python3-genpy`` and ``python3-std-msgs`` in ``/usr/lib/python3/dist-packages``. The project's virtual environment
+imports them once that folder is on ``sys.path``; it is **appended** (never prepended) so the environment's own
+numpy and PyYAML keep precedence over Debian's copies.
+
+A lab program (``lab2_exec.py``) needs ``rospy`` and the course's ``ur3_driver.msg`` package.
+:func:`write_client_env` writes a folder with the generated ``ur3_driver`` package (see :mod:`ur3hanoi.ros.msgs`)
+and a ``sitecustomize.py`` that appends Debian's folder, so that ``PYTHONPATH=<folder>`` is all a Python 3 (the
+venv's or Debian's own) needs; :func:`env_lines` are the shell lines ``ur3hanoi ros-env`` prints.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import os
+import shlex
+import shutil
+import sys
+from pathlib import Path
+from types import ModuleType
+
+from ur3hanoi.ros.errors import RosUnavailableError
+
+ROS_PYTHON_DIR = Path("/usr/lib/python3/dist-packages")
+"""Where Debian installs rospy, genpy, genmsg and std_msgs."""
+
+DEBIAN_PACKAGES: tuple[str, ...] = ("ros-core", "python3-rospy", "python3-genpy", "python3-std-msgs")
+"""The Debian packages ur3hanoi's ROS commands need (``tools/ensure-system-deps.sh`` installs them)."""
+
+_ROS_MODULES: tuple[str, ...] = ("rospy", "genpy", "genmsg", "std_msgs")
+
+_INSTALL_HINT = (f"install Debian's packages {' '.join(DEBIAN_PACKAGES)} (as root: bash tools/ensure-system-deps.sh, "
+                 f"or apt-get install -y {' '.join(DEBIAN_PACKAGES)})")
+
+
+def ensure_ros_python() -> None:
+    """Make rospy, genpy, genmsg and std_msgs importable, appending :data:`ROS_PYTHON_DIR` to ``sys.path``.
+
+    Raises:
+        RosUnavailableError: a module is still not importable; the message names the Debian packages.
+    """
+    folder = str(ROS_PYTHON_DIR)
+    if ROS_PYTHON_DIR.is_dir() and folder not in sys.path:
+        sys.path.append(folder)
+    missing = [m for m in _ROS_MODULES if importlib.util.find_spec(m) is None]
+    if missing:
+        raise RosUnavailableError(f"ROS 1 Python modules {', '.join(missing)} are not importable (searched sys.path "
+                                  f"and {folder}): {_INSTALL_HINT}")
+
+
+def import_rospy() -> ModuleType:
+    """The ``rospy`` module (after :func:`ensure_ros_python`)."""
+    ensure_ros_python()
+    return importlib.import_module("rospy")
+
+
+def import_std_msgs() -> ModuleType:
+    """The ``std_msgs.msg`` module (``Int32`` for the station's spawn and fault topics)."""
+    ensure_ros_python()
+    return importlib.import_module("std_msgs.msg")
+
+
+def roscore_executable() -> str:
+    """Path of ``roscore``.
+
+    Raises:
+        RosUnavailableError: not on PATH (package ``ros-core`` missing).
+    """
+    path = shutil.which("roscore")
+    if path is None:
+        raise RosUnavailableError(f"roscore is not on PATH: {_INSTALL_HINT}")
+    return path
+
+
+def default_cache_dir() -> Path:
+    """``$XDG_CACHE_HOME/ur3hanoi/ros`` (``~/.cache/ur3hanoi/ros`` when XDG_CACHE_HOME is unset)."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "ur3hanoi" / "ros"
+
+
+SITECUSTOMIZE = f'''"""Written by `ur3hanoi ros-env`: lets any Python 3 import Debian's ROS 1 packages (rospy,
+genpy) and the course's ur3_driver messages beside this file. Debian's folder is APPENDED to sys.path, so a virtual
+environment's own packages (numpy, PyYAML) keep precedence. Then runs the next sitecustomize on the path (e.g.
+Debian's), which this file would otherwise hide."""
+import importlib.util as _util
+import os as _os
+import sys as _sys
+
+_ROS = {str(ROS_PYTHON_DIR)!r}
+if _os.path.isdir(_ROS) and _ROS not in _sys.path:
+    _sys.path.append(_ROS)
+
+
+def _chain():
+    here = _os.path.dirname(_os.path.abspath(__file__))
+    for entry in list(_sys.path):
+        folder = _os.path.abspath(entry or ".")
+        path = _os.path.join(folder, "sitecustomize.py")
+        if folder != here and _os.path.isfile(path):
+            spec = _util.spec_from_file_location("_ur3hanoi_next_sitecustomize", path)
+            if spec is not None and spec.loader is not None:
+                spec.loader.exec_module(_util.module_from_spec(spec))
+            return
+
+
+_chain()
+'''
+
+
+def write_client_env(folder: Path) -> list[Path]:
+    """Write the ``ur3_driver`` message package and the ``sitecustomize.py`` described above into ``folder``.
+
+    Returns the files written. Existing files are replaced atomically; nothing else in ``folder`` is touched.
+    """
+    from ur3hanoi.io.atomic import atomic_write
+    from ur3hanoi.ros.msgs import write_message_package
+
+    written = write_message_package(folder)
+    site = folder / "sitecustomize.py"
+    atomic_write(site, SITECUSTOMIZE)
+    return [*written, site]
+
+
+def env_lines(folder: Path, master_uri: str) -> list[str]:
+    """The ``export`` lines that let a lab program in this shell talk to ``master_uri`` with the messages in
+    ``folder`` (POSIX shell syntax, for ``eval "$(ur3hanoi ros-env)"``)."""
+    quoted = shlex.quote(str(folder))
+    return [
+        f"export ROS_MASTER_URI={shlex.quote(master_uri)}",
+        f"export PYTHONPATH={quoted}${{PYTHONPATH:+:$PYTHONPATH}}",
+    ]
