@@ -20,13 +20,22 @@ import mujoco
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.grid import block_center_world
 from ur3hanoi.hanoi import block_colour
 from ur3hanoi.robot import JOINT_NAMES
 from ur3hanoi.ros.command import MoveCommand
 from ur3hanoi.ros.errors import RosError
 from ur3hanoi.ros.movej import MoveJ, plan_movej
-from ur3hanoi.sim import FinalBlock, GripperInput, SceneConfig, SuctionConfig, SuctionCup, build_task_scene, start_slots
+from ur3hanoi.sim import (
+    FinalBlock,
+    GripperInput,
+    SceneConfig,
+    SuctionConfig,
+    SuctionCup,
+    build_task_scene,
+    slot_centers,
+    slot_of,
+    start_slots,
+)
 from ur3hanoi.station import Station
 
 
@@ -110,8 +119,7 @@ class StationWorld:
         self._ff = kv / kp  # velocity feed-forward [s]: servo force kp (q_ref - q) + kv (qd_ref - qd)
         self.cup = SuctionCup(self.scene, cfg.suction, seed=cfg.seed)
         self.events: list[WorldEvent] = []
-        self._centers = np.array([[block_center_world(station, t, h) for h in range(station.n_heights)]
-                                  for t in range(station.n_towers)])
+        self._centers = slot_centers(station)
         floor = m.geom("floor")
         floor_z = float(m.geom_pos[floor.id][2])
         s = station.block_size
@@ -277,9 +285,7 @@ class StationWorld:
         tol = self.config.place_tolerance_m
         for b in range(self.n_blocks):
             xyz = self.scene.block_pos(b)
-            dist = np.linalg.norm(self._centers - xyz, axis=-1)
-            t, h = np.unravel_index(int(np.argmin(dist)), dist.shape)
-            slot = (int(t), int(h)) if dist[t, h] <= tol else None
+            slot = slot_of(self._centers, xyz, tol)
             out.append(FinalBlock(b, None if slot is None else slot[0], None if slot is None else slot[1],
                                   (float(xyz[0]), float(xyz[1]), float(xyz[2]))))
         return tuple(out)

@@ -47,6 +47,7 @@ from ur3hanoi.sim.scene import (
     build_task_scene,
     build_task_spec,
     slot_centers,
+    slot_of,
     start_slots,
     warning_counts,
 )
@@ -84,6 +85,7 @@ __all__ = [
     "display_available",
     "run_plan",
     "slot_centers",
+    "slot_of",
     "start_slots",
     "ur3_mesh_sources",
     "warning_counts",

@@ -37,7 +37,7 @@ from ur3hanoi.plan import Phase, Plan, Trajectory
 from ur3hanoi.robot import JOINT_NAMES, N_JOINTS
 from ur3hanoi.sim.halt import DEFAULT_HALT_PROFILE, HaltProfile
 from ur3hanoi.sim.result import DisplacedBlock, FeedbackEvent, FinalBlock, JointTrace, SimResult
-from ur3hanoi.sim.scene import SceneConfig, TaskScene, build_task_scene, slot_centers, warning_counts
+from ur3hanoi.sim.scene import SceneConfig, TaskScene, build_task_scene, slot_centers, slot_of, warning_counts
 from ur3hanoi.sim.suction import GripperInput, SuctionConfig, SuctionCup
 
 
@@ -84,15 +84,6 @@ class FrameSink(Protocol):
 
 
 ProgressFn = Callable[[float, str], None]
-
-
-def _slot_of(centers: FloatArray, xyz: FloatArray, tol: float) -> tuple[int, int] | None:
-    """The first slot (tower, height) whose centre (``centers`` from :func:`slot_centers`) is within ``tol``."""
-    for t, row in enumerate(centers):
-        for h, c in enumerate(row):
-            if np.linalg.norm(c - xyz) <= tol:
-                return t, h
-    return None
 
 
 @dataclass(frozen=True)
@@ -319,7 +310,7 @@ class _Run:
         displaced = []
         for b in sorted(scene.block_body):
             xyz = scene.block_pos(b)
-            slot = _slot_of(centers, xyz, self.cfg.place_tolerance)
+            slot = slot_of(centers, xyz, self.cfg.place_tolerance)
             if slot != expected[b]:
                 displaced.append((b, slot, xyz))
         absent += [b for b, slot, _ in displaced if slot is None]
@@ -380,7 +371,7 @@ class _Run:
         centers = slot_centers(self.plan.station)
         for b in sorted(self.scene.block_body):
             xyz = self.scene.block_pos(b)
-            slot = _slot_of(centers, xyz, self.cfg.place_tolerance)
+            slot = slot_of(centers, xyz, self.cfg.place_tolerance)
             final.append(FinalBlock(b, None if slot is None else slot[0], None if slot is None else slot[1],
                                     (float(xyz[0]), float(xyz[1]), float(xyz[2]))))
         return final
@@ -398,7 +389,7 @@ class _Run:
         for b, before in sorted(fault.resting.items()):
             moved = float(np.linalg.norm(self.scene.block_pos(b) - before))
             if moved > self.cfg.knock_tolerance:
-                slot = _slot_of(centers, before, self.cfg.place_tolerance)
+                slot = slot_of(centers, before, self.cfg.place_tolerance)
                 out.append(DisplacedBlock(b, None if slot is None else slot[0], None if slot is None else slot[1],
                                           moved))
         return out

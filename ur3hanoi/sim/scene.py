@@ -61,6 +61,14 @@ def slot_centers(station: Station) -> FloatArray:
                      for t in range(station.n_towers)])
 
 
+def slot_of(centers: FloatArray, xyz: FloatArray, tolerance: float) -> tuple[int, int] | None:
+    """The slot (tower, height), 0-based, whose block centre is nearest ``xyz`` [m, world], if within
+    ``tolerance`` [m]; None when the block is in no slot. ``centers`` from :func:`slot_centers`."""
+    dist = np.linalg.norm(centers - xyz, axis=-1)
+    t, h = np.unravel_index(int(np.argmin(dist)), dist.shape)
+    return (int(t), int(h)) if dist[t, h] <= tolerance else None
+
+
 def block_name(block: int) -> str:
     """MuJoCo body name of block ``block`` (0-based, 0 = bottom/green)."""
     return f"block{block + 1}_{block_colour(block)}"
