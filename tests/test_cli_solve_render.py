@@ -78,3 +78,10 @@ def test_bad_render_options_exit_2_before_rendering(tmp_path: Path, capsys: pyte
     captured = capsys.readouterr()
     assert message in captured.err and captured.err.count("\n") == 1 and captured.out == ""
     assert not frames.exists() or not any(frames.glob("*.png"))
+
+
+def test_the_help_lists_the_video_formats_the_recorder_writes() -> None:
+    from ur3hanoi.cli.solve import VIDEO_EXTENSIONS
+    from ur3hanoi.sim import VIDEO_FORMATS
+
+    assert tuple(VIDEO_FORMATS) == VIDEO_EXTENSIONS

@@ -85,13 +85,13 @@ def test_no_frame_in_the_window_leaves_no_video(scene: TaskScene, tmp_path: Path
     assert rec.count == 0 and not video.exists()
 
 
-def test_images_larger_than_the_default_framebuffer(scene: TaskScene, tmp_path: Path) -> None:
-    model = scene.model
-    big = CameraConfig(width=720, height=96)
-    rec = _recorder(scene, frames_dir=tmp_path, camera=big)
+def test_images_wider_than_the_models_framebuffer(tmp_path: Path) -> None:
+    scene = build_task_scene(STATIONS["lab_sim"], 0, 1)  # its own model: the recorder grows the framebuffer
+    width = int(scene.model.vis.global_.offwidth) + 64  # the scene's XML sets 1280 x 720
+    rec = _recorder(scene, frames_dir=tmp_path, camera=CameraConfig(width=width, height=32))
     _offer(rec, scene, [0.0])
-    assert Image.open(tmp_path / "frame_00000.png").size == (720, 96)
-    assert model.vis.global_.offwidth >= 720
+    assert Image.open(tmp_path / "frame_00000.png").size == (width, 32)
+    assert scene.model.vis.global_.offwidth >= width
 
 
 @pytest.mark.parametrize("name", ["run.avi", "run.mp5", "run", "run.mp4.part"])

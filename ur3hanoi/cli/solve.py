@@ -171,8 +171,8 @@ def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
     from ur3hanoi.sim.render import check_video_path
 
     if args.video:
+        check_output(args.video, inputs=inputs)  # first: "it is a directory" says more than "no extension"
         check_video_path(args.video)
-        check_output(args.video, inputs=inputs)
     if args.frames:
         try:
             Path(args.frames).mkdir(parents=True, exist_ok=True)

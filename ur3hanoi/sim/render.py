@@ -142,6 +142,8 @@ class OffscreenRecorder:
         vis.offwidth, vis.offheight = max(vis.offwidth, cam.width), max(vis.offheight, cam.height)
         try:
             self.renderer = mujoco.Renderer(model, cam.height, cam.width)
+        except ValueError:  # a size the framebuffer does not hold: a bug here, not a missing OpenGL
+            raise
         except Exception as exc:  # no OpenGL context: the message says which backend failed
             raise SimulationError(f"offscreen rendering is unavailable ({exc}); on a headless machine set "
                                   "MUJOCO_GL=egl (libegl1) or MUJOCO_GL=osmesa (libosmesa6)") from None
