@@ -38,6 +38,9 @@ TOWER = Number(1, MAX_TOWERS, integer=True, what="a tower number (1-based)")
 BLOCKS = Number(1, MAX_BLOCKS, integer=True, what="a number of blocks")
 HEIGHT = Number(1, MAX_HEIGHTS, integer=True, what="a height (1-based)")
 MOVE = Number(1, 2**MAX_BLOCKS - 1, integer=True, what="a move number (1-based)")
+FPS = Number(1.0, 120.0, unit="Hz", what="a frame rate")  # at most one frame per 125 Hz control cycle
+IMAGE_SIDE = Number(16, 4096, integer=True, unit="px", what="an image side")
+SIM_TIME = Number(0.0, 1e6, unit="s", what="a sim time")
 # ROS commands (ros-station, ros-solve).
 ROS_RATE = Number(50.0, 500.0, unit="Hz", what="a control and publishing rate")
 CMD_SPEED = Number(0.0, 10.0, lo_open=True, unit="rad/s", what="a commanded joint speed (the driver caps it)")
@@ -70,6 +73,23 @@ def option(spec: Number) -> Callable[[str], float | int]:
 
     parse.__name__ = spec.what or "number"
     return parse
+
+
+def image_size(text: str) -> tuple[int, int]:
+    """An argparse ``type=`` for ``WxH`` [px]: two integers in :data:`IMAGE_SIDE`, both even (H.264/VP9 video
+    needs even sides; PNG frames follow the same rule so one size works for both)."""
+    parts = text.strip().lower().split("x")
+    sides = [_parse(p, integer=True) for p in parts] if len(parts) == 2 else []
+    if len(sides) != 2 or not all(v is not None and IMAGE_SIDE.accepts(v) and v % 2 == 0 for v in sides):
+        raise argparse.ArgumentTypeError(f"{quote(text)} is invalid: expected WIDTHxHEIGHT, e.g. 640x480, each "
+                                         f"an even number of pixels in [{IMAGE_SIDE.lo:g}, {IMAGE_SIDE.hi:g}]")
+    return int(sides[0]), int(sides[1])  # type: ignore[arg-type]
+
+
+def check_window(t_from: float | None, t_to: float | None) -> None:
+    """The render window ``--from``/``--to`` [s] must not be empty (``--from`` defaults to 0)."""
+    if t_to is not None and not t_to > (t_from or 0.0):
+        raise UsageError(f"--to {t_to:g} is invalid: expected a time after --from ({t_from or 0.0:g} s)")
 
 
 def check_blocks(n_blocks: int, n_heights: int, given: bool) -> None:

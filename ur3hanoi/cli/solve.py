@@ -1,4 +1,14 @@
-"""``ur3hanoi solve``: run the lab in MuJoCo (plan, execute with suction feedback, verify)."""
+"""``ur3hanoi solve``: run the lab in MuJoCo (plan, execute with suction feedback, verify).
+
+With ``--table FILE --key KEY`` the arm follows that table's waypoints (:func:`ur3hanoi.plan.plan_table`) instead
+of the ones ur3hanoi generates from the calibration. The scene is the calibration's: ``--key sim_pos`` defaults to
+the shipped ``lab_sim`` (the course's Gazebo world, which ``sim_pos`` tables are recorded in); ``--key real_pos``
+requires ``--calibration`` (a real station's table fits only that station's geometry).
+
+Rendering (``--video``/``--frames``) takes ``--fps``, ``--size WxH`` and a sim-time window ``--from``/``--to``.
+Progress goes to stderr: a bar on a terminal; plain lines every 10 % when stderr is not a terminal and the run
+renders, or with ``--progress``. Standard output carries only the result (one JSON object with ``--json``).
+"""
 
 from __future__ import annotations
 
@@ -7,23 +17,39 @@ import math
 import os
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ur3hanoi.cli import exit_codes
 from ur3hanoi.cli.common import DEFAULT_CALIBRATION, calibration_ref, input_file, shown
 from ur3hanoi.cli.options import (
     BLOCKS,
+    FPS,
     HEIGHT,
     MOVE,
     SEED,
+    SIM_TIME,
     SPEED,
     TOWER,
     UsageError,
     check_blocks,
     check_faults,
     check_plan_size,
+    check_window,
+    image_size,
     option,
 )
 from ur3hanoi.errors import OutputError, SuctionFaultError, Ur3HanoiError, printable
+from ur3hanoi.labfile import TABLE_KEYS
+
+if TYPE_CHECKING:
+    from ur3hanoi.sim import ProgressFn
+
+VIDEO_EXTENSIONS = (".mp4", ".mkv", ".mov", ".webm", ".gif")
+"""The video extensions, for the help text (kept equal to ``ur3hanoi.sim.VIDEO_FORMATS``, which is not imported
+here: building the parser must not load MuJoCo)."""
+
+PROGRESS_STEP = 0.1
+"""Fraction of the run between two plain progress lines (when stderr is not a terminal)."""
 
 
 def add(sub: argparse._SubParsersAction) -> None:
@@ -38,7 +64,13 @@ def add(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--blocks", type=option(BLOCKS), default=None, metavar="N",
                    help=f"{BLOCKS.expected()} (default: the grid's heights, 3 on the lab)")
     p.add_argument("--calibration", default=None, metavar="CAL",
-                   help=f"station calibration YAML (default {DEFAULT_CALIBRATION})")
+                   help=f"station calibration YAML, or a shipped station name (default {DEFAULT_CALIBRATION}; "
+                        "required with --key real_pos)")
+    p.add_argument("--table", metavar="FILE",
+                   help="follow the waypoints of this lab-format table (lab2_data.yaml) instead of generated ones: "
+                        "joint moves between its entries like the lab program; a missed block halts (exit 3) "
+                        "naming the table entry")
+    p.add_argument("--key", choices=TABLE_KEYS, help="the table key to follow (with --table)")
     p.add_argument("--remove-block", type=option(HEIGHT), metavar="H",
                    help="fault injection: spawn without the block at height H (1-based), like lab2_spawn.py")
     p.add_argument("--drop-during-move", type=option(MOVE), metavar="M",
@@ -49,9 +81,21 @@ def add(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=option(SEED), default=0, metavar="K",
                    help=f"seed of the suction feedback noise, an integer in [0, {SEED.hi}]")
     out = p.add_mutually_exclusive_group()
-    out.add_argument("--video", metavar="FILE.mp4",
-                     help="render an MP4 offscreen (needs imageio + imageio-ffmpeg; headless: MUJOCO_GL=egl)")
+    out.add_argument("--video", metavar="FILE",
+                     help=f"render a video offscreen, by extension {', '.join(VIDEO_EXTENSIONS)} (needs "
+                          "imageio-ffmpeg; headless: MUJOCO_GL=egl)")
     out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR (headless: MUJOCO_GL=egl)")
+    p.add_argument("--fps", type=option(FPS), default=None, metavar="HZ",
+                   help=f"frames per second of sim time, {FPS.expected()} (default 30)")
+    p.add_argument("--size", type=image_size, default=None, metavar="WxH",
+                   help="image size in pixels, even numbers in [16, 4096] (default 640x480)")
+    p.add_argument("--from", dest="t_from", type=option(SIM_TIME), default=None, metavar="S",
+                   help="render from this sim time [s] on (default 0)")
+    p.add_argument("--to", dest="t_to", type=option(SIM_TIME), default=None, metavar="S",
+                   help="render up to this sim time [s] (default: the end)")
+    p.add_argument("--progress", action="store_true",
+                   help="report progress on stderr also when it is not a terminal (plain lines every 10 %%; on by "
+                        "default when rendering)")
     p.add_argument("--view", action="store_true", help="open MuJoCo's interactive viewer (needs a display)")
     p.add_argument("--json", action="store_true", help="print one JSON object with the outcome on stdout")
     p.set_defaults(func=run)
@@ -81,12 +125,54 @@ def _progress(fraction: float, label: str) -> None:
           file=sys.stderr, flush=True)
 
 
+class _ProgressLines:
+    """Progress as plain stderr lines every :data:`PROGRESS_STEP` of the run (for logs and pipes), with the
+    number of frames written so far when rendering."""
+
+    def __init__(self, recorder: object | None) -> None:
+        self.recorder = recorder
+        self.reported = -1
+
+    def __call__(self, fraction: float, label: str) -> None:
+        step = math.floor(fraction / PROGRESS_STEP + 1e-9)
+        if step <= self.reported:
+            return
+        self.reported = step
+        frames = getattr(self.recorder, "count", None)
+        extra = f", {frames} frames" if frames is not None else ""
+        print(f"ur3hanoi solve: {100 * fraction:3.0f} % ({label}{extra})", file=sys.stderr, flush=True)
+
+
+def _progress_sink(args: argparse.Namespace, recorder: object | None) -> ProgressFn | None:
+    """A bar on a terminal; plain lines when rendering or with --progress; nothing otherwise (and never with
+    --view, whose window shows the run)."""
+    if args.view:
+        return None
+    if sys.stderr.isatty():
+        return _progress
+    if args.progress or args.video or args.frames:
+        return _ProgressLines(recorder)
+    return None
+
+
+def _check_render_options(args: argparse.Namespace) -> None:
+    """Render settings only make sense with an output to render into."""
+    given = [name for name, value in (("--fps", args.fps), ("--size", args.size), ("--from", args.t_from),
+                                      ("--to", args.t_to)) if value is not None]
+    if given and not (args.video or args.frames):
+        raise UsageError(f"{', '.join(given)} set{'s' if len(given) == 1 else ''} how the run is rendered: use "
+                         "with --video FILE or --frames DIR")
+    check_window(args.t_from, args.t_to)
+
+
 def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
     """Refuse a video or frames path that cannot be written, before simulating anything."""
     from ur3hanoi.io.atomic import check_output
+    from ur3hanoi.sim.render import check_video_path
 
     if args.video:
-        check_output(args.video, inputs=inputs)
+        check_output(args.video, inputs=inputs)  # first: "it is a directory" says more than "no extension"
+        check_video_path(args.video)
     if args.frames:
         try:
             Path(args.frames).mkdir(parents=True, exist_ok=True)
@@ -109,15 +195,39 @@ def _towers(args: argparse.Namespace, n_towers: int) -> tuple[int, int]:
     return start, end
 
 
+def _table_calibration(args: argparse.Namespace) -> str:
+    """The calibration to simulate on: given, the default one, or (for a real station's table) required."""
+    if args.table is None:
+        if args.key is not None:
+            raise UsageError("--key names the key of a table to follow: use with --table FILE")
+        return calibration_ref(args.calibration)
+    if args.key is None:
+        raise UsageError(f"--table needs --key ({' or '.join(TABLE_KEYS)}): which of the file's tables to follow")
+    if args.calibration is None and args.key == "real_pos":
+        raise UsageError("--key real_pos needs --calibration CAL: a real station's table fits only the station it "
+                         f"was recorded on (sim_pos tables default to {DEFAULT_CALIBRATION})")
+    return calibration_ref(args.calibration)
+
+
 def run(args: argparse.Namespace) -> int:
     import json
 
     from ur3hanoi.hanoi import validate_instance
-    from ur3hanoi.plan import PlanConfig, plan_solve
+    from ur3hanoi.plan import PlanConfig, plan_solve, plan_table
     from ur3hanoi.station import load_station
 
-    inputs = [input_file(calibration_ref(args.calibration))]
-    station = load_station(calibration_ref(args.calibration))
+    _check_render_options(args)
+    cal = _table_calibration(args)
+    inputs = [input_file(cal)]
+    station = load_station(cal)
+    table = None
+    if args.table is not None:
+        from ur3hanoi.labfile import read_table
+        from ur3hanoi.plan import check_table_shape
+
+        inputs.append(Path(args.table))
+        table = read_table(args.table, args.key)
+        check_table_shape(table, station, f"{args.table}:{args.key}")
     n_towers = station.n_towers
     n_blocks = station.n_heights if args.blocks is None else args.blocks
     check_blocks(n_blocks, station.n_heights, given=args.blocks is not None)
@@ -126,11 +236,13 @@ def run(args: argparse.Namespace) -> int:
     check_faults(args.remove_block, args.drop_during_move, n_blocks)
     plan_config = PlanConfig(speed=args.speed)
     check_plan_size(n_blocks, args.speed, plan_config.dwell_s, plan_config.rate_hz)
-    _check_render_outputs(args, inputs)
     if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
-        os.environ["MUJOCO_GL"] = "egl"  # headless offscreen rendering (read when the GL context is created)
+        # Headless offscreen rendering: read when MuJoCo is first imported (the output check below imports it).
+        os.environ["MUJOCO_GL"] = "egl"
+    _check_render_outputs(args, inputs)
 
     from ur3hanoi.sim import (
+        CameraConfig,
         Faults,
         OffscreenRecorder,
         SimConfig,
@@ -148,7 +260,13 @@ def run(args: argparse.Namespace) -> int:
         drop_during_move=None if args.drop_during_move is None else args.drop_during_move - 1,
     )
     config = SimConfig(seed=args.seed)
-    plan = plan_solve(station, start, end, n_blocks, plan_config)
+    if table is not None:
+        plan = plan_table(station, table, start, end, n_blocks, plan_config, where=f"{args.table}:{args.key}")
+    else:
+        plan = plan_solve(station, start, end, n_blocks, plan_config)
+    if args.t_from is not None and args.t_from >= plan.duration_s:
+        raise UsageError(f"--from {args.t_from:g} is invalid: the planned motion lasts {plan.duration_s:.2f} s of "
+                         "sim time: expected an earlier time")
     scene = build_task_scene(station, start, n_blocks, faults.remove_block, config.scene)
     sink: object | None = None
     fault: Ur3HanoiError | None = None
@@ -156,9 +274,13 @@ def run(args: argparse.Namespace) -> int:
         if args.view:
             sink = ViewerSink(scene.model, scene.data)
         elif args.video or args.frames:
+            default = CameraConfig()
+            width, height = args.size if args.size is not None else (default.width, default.height)
+            camera = CameraConfig(width=width, height=height, fps=args.fps if args.fps is not None else default.fps)
             sink = OffscreenRecorder(station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
-                                     video=Path(args.video) if args.video else None)
-        progress = _progress if sys.stderr.isatty() and not args.view else None
+                                     video=Path(args.video) if args.video else None, camera=camera,
+                                     t_from=args.t_from or 0.0, t_to=args.t_to)
+        progress = _progress_sink(args, sink if args.video or args.frames else None)
         try:
             result = run_plan(plan, faults, config, frames=sink, progress=progress,  # type: ignore[arg-type]
                               scene=scene, realtime=args.view)
@@ -172,10 +294,14 @@ def run(args: argparse.Namespace) -> int:
             sink.close()  # type: ignore[attr-defined]
 
     if args.json:
-        print(json.dumps(result.as_dict()))
+        out = result.as_dict()
+        if args.table is not None:
+            out["table"] = {"file": str(args.table), "key": args.key}
+        print(json.dumps(out))
     else:
+        following = f", following {shown(args.table)}:{args.key}" if args.table is not None else ""
         print(f"{result.status}: {result.moves_completed}/{result.moves_total} moves, tower {start + 1} -> "
-              f"{end + 1}, {len(result.final_blocks)} blocks on {shown(station.name)}")
+              f"{end + 1}, {len(result.final_blocks)} blocks on {shown(station.name)}{following}")
         for b in result.final_blocks:
             where = "in no slot"
             if b.tower is not None and b.height is not None:

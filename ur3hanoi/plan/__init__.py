@@ -23,6 +23,8 @@ Module map (dependencies flow downward only):
   (what ``ur3hanoi plan`` prints).
 - :mod:`~ur3hanoi.plan.planner`: :func:`plan_moves` / :func:`plan_solve`: waypoints -> segments -> samples ->
   checks -> :class:`Plan`.
+- :mod:`~ur3hanoi.plan.table_plan`: :func:`plan_table`: the same :class:`Plan` through the waypoints of a given
+  lab table, moved like the lab program (rest-to-rest joint moves; limits checked, no vertical line).
 
 CONTRACT (shared with ur3hanoi.sim; keep these names and meanings):
 
@@ -46,6 +48,7 @@ from ur3hanoi.plan.export import trajectory_csv
 from ur3hanoi.plan.planner import plan_moves, plan_solve
 from ur3hanoi.plan.ruckig import OfflineRuckig, RuckigSolution, control_samples, to_pose, to_rest
 from ur3hanoi.plan.sampling import sample
+from ur3hanoi.plan.table_plan import check_table_shape, entries_visited, entry_label, missing_entries, plan_table
 from ur3hanoi.plan.types import (
     DEFAULT_VIA_FRACTIONS,
     DWELL_PHASES,
@@ -80,10 +83,15 @@ __all__ = [
     "build_waypoints",
     "check_collisions",
     "check_limits",
+    "check_table_shape",
     "check_vertical",
     "control_samples",
+    "entries_visited",
+    "entry_label",
+    "missing_entries",
     "plan_moves",
     "plan_solve",
+    "plan_table",
     "sample",
     "tcp_positions_world",
     "to_pose",

@@ -17,7 +17,8 @@ Modules, in order of dependency (each imports only the ones above it):
   the lab program, halts on a fault (raising :class:`ur3hanoi.errors.SuctionFaultError` with the result) and
   verifies the final block positions (:class:`Faults`, :class:`SimConfig`).
 - :mod:`~ur3hanoi.sim.render`: offscreen frames/video and the interactive viewer (:class:`CameraConfig`,
-  :class:`OffscreenRecorder`, :class:`ViewerSink`, :func:`display_available`).
+  :class:`OffscreenRecorder`, :data:`VIDEO_FORMATS`, :func:`check_video_path`, :class:`ViewerSink`,
+  :func:`display_available`).
 
 Frames: MuJoCo's world is the station's world. The URDF root ``base_link`` is placed at
 ``T_world_base * Rz(pi)`` so that MuJoCo's ``suction`` site equals ``T_world_base * Ur3Model.fk(q, "tcp")``.
@@ -38,7 +39,15 @@ from ur3hanoi.sim.model import (
     ur3_mesh_sources,
     write_ur3_files,
 )
-from ur3hanoi.sim.render import CameraConfig, OffscreenRecorder, ViewerSink, display_available
+from ur3hanoi.sim.render import (
+    VIDEO_FORMATS,
+    CameraConfig,
+    OffscreenRecorder,
+    VideoFormat,
+    ViewerSink,
+    check_video_path,
+    display_available,
+)
 from ur3hanoi.sim.result import DisplacedBlock, FeedbackEvent, FinalBlock, JointTrace, SimResult
 from ur3hanoi.sim.scene import (
     SceneConfig,
@@ -59,6 +68,7 @@ __all__ = [
     "ROBOT_DIR",
     "SCENE_XML",
     "UR3_XML",
+    "VIDEO_FORMATS",
     "CameraConfig",
     "DisplacedBlock",
     "Faults",
@@ -77,10 +87,12 @@ __all__ = [
     "SuctionConfig",
     "SuctionCup",
     "TaskScene",
+    "VideoFormat",
     "ViewerSink",
     "block_name",
     "build_task_scene",
     "build_task_spec",
+    "check_video_path",
     "derive_ur3_mjcf",
     "display_available",
     "run_plan",

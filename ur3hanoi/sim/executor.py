@@ -165,6 +165,9 @@ class _Run:
                 raise SimulationError(f"move {faults.drop_during_move + 1} has no CARRY phase to drop the block in")
             self.drop_k = int(ks[ks.size // 2])
         self.drop_time: float | None = None
+        # Per move: the closest the cup (suction point) came to the grasp point of the block to pick during the
+        # grasp dwell [m], for the message when nothing was grasped.
+        self.closest_grasp: dict[int, float] = {}
         self.max_err = 0.0
         self.moves_completed = 0
         self.trace: list[tuple[float, int, float]] = []  # (t [s], DIGIN, AIN0 [V]) every control cycle
@@ -220,6 +223,7 @@ class _Run:
         release = tr.phase == Phase.RELEASE_DWELL
         completes = np.append(False, release[:-1] & ~release[1:]).tolist()  # first sample after a release dwell
         flags = self._check_flags()
+        grasping = (tr.phase == Phase.GRASP_DWELL).tolist()
         fault = None
         k = 0
         for k in range(1, n):
@@ -241,6 +245,8 @@ class _Run:
                 self.max_err = float(err)
             if completes[k]:
                 self.moves_completed += 1
+            if grasping[k] and cup.attached is None:
+                self._track_grasp(mv)
             fault = self.check_suction(k, mv, fb, flags)
             if fault is not None:
                 break
@@ -248,6 +254,15 @@ class _Run:
                 self.progress(k / (n - 1), f"move {max(mv, 0) + 1}/{len(moves)}")
         self.ref_chunks.append((tr.q[:k + 1], tr.qd[:k + 1], tr.qdd[:k + 1]))
         return fault
+
+    def _track_grasp(self, mv: int) -> None:
+        """Update the closest approach of the cup to the grasp point of move ``mv``'s block (see the grasp rule,
+        :class:`~ur3hanoi.sim.SuctionConfig.grasp_radius`)."""
+        block = self.plan.moves[mv].block
+        if block in self.scene.block_body:
+            p_cup = self.d.site_xpos[self.scene.site_id]
+            dist = float(np.linalg.norm(self.cup.expected_suction_point(block) - p_cup))
+            self.closest_grasp[mv] = min(dist, self.closest_grasp.get(mv, math.inf))
 
     def _inject_drop(self, mv: int) -> None:
         lost = self.cup.lose_block()
@@ -313,6 +328,11 @@ class _Run:
             slot = slot_of(centers, xyz, self.cfg.place_tolerance)
             if slot != expected[b]:
                 displaced.append((b, slot, xyz))
+        missed = self._missed_grasp(mv)
+        if not absent and not displaced and missed:
+            # Every block is where the plan expects it: the cup did not reach the block (e.g. a table entry off).
+            return move.block, (f"{block_colour(move.block)} block {move.block + 1} at tower {move.from_tower + 1} "
+                                f"height {move.from_height + 1} was not grasped {sensed}: {missed}")
         absent += [b for b, slot, _ in displaced if slot is None]
         missing = absent[0] if absent else move.block
         t, h = expected[missing]
@@ -324,6 +344,18 @@ class _Run:
         found = [f"{block_colour(b)} block {b + 1} is {_slot_text(slot, xyz)}" for b, slot, xyz in displaced
                  if slot is not None]
         return missing, text + (f" ({', '.join(found)})" if found else "")
+
+    def _missed_grasp(self, mv: int) -> str:
+        """How close the cup came to the grasp point of move ``mv``'s block in its grasp dwell, and at which
+        waypoint (the plan's segment target: a table entry for a table plan); "" when not measured."""
+        dist = self.closest_grasp.get(mv)
+        if dist is None:
+            return ""
+        target = next((s.target for s in self.plan.segments if s.phase == Phase.GRASP_DWELL and s.move_index == mv),
+                      "")
+        at = f" at {target}" if target else ""
+        return (f"the cup (suction point) came no closer than {dist * 1e3:.1f} mm to its grasp point{at} (a grasp "
+                f"needs {self.cfg.suction.grasp_radius * 1e3:g} mm or less)")
 
     # ------------------------------------------------------------------------------------------ 3. halt / settle
 

@@ -1,11 +1,17 @@
-"""Seeing a run: offscreen rendering to PNG frames or an MP4 (:class:`OffscreenRecorder`) and MuJoCo's interactive
+"""Seeing a run: offscreen rendering to PNG frames or a video (:class:`OffscreenRecorder`) and MuJoCo's interactive
 viewer (:class:`ViewerSink`). Both are frame sinks for :func:`ur3hanoi.sim.run_plan` (``frames=``).
+
+Videos are encoded by the ffmpeg binary of the ``imageio-ffmpeg`` wheel; the container follows the file's
+extension (:data:`VIDEO_FORMATS`: ``.mp4``, ``.mkv``, ``.mov`` with H.264, ``.webm`` with VP9, ``.gif``), and
+:func:`check_video_path` refuses any other extension before anything is simulated. The recorder renders only
+inside its time window (``t_from``..``t_to`` [s] of sim time) and sizes MuJoCo's offscreen framebuffer to the image.
 
 Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo is imported.
 """
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -14,9 +20,47 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from ur3hanoi.errors import SimulationError
+from ur3hanoi.errors import OutputError, SimulationError, printable, quote
 from ur3hanoi.sim.scene import slot_centers
 from ur3hanoi.station import Station
+
+
+@dataclass(frozen=True)
+class VideoFormat:
+    """How a video container is encoded by ffmpeg: ``codec``, output pixel format, the imageio-ffmpeg ``quality``
+    (0-10; None: codec default, ``params`` set it) and extra ffmpeg output ``params``."""
+
+    codec: str
+    pix_fmt: str = "yuv420p"
+    quality: float | None = 7.0
+    params: tuple[str, ...] = ()
+
+
+VIDEO_FORMATS: dict[str, VideoFormat] = {
+    ".mp4": VideoFormat("libx264"),
+    ".mkv": VideoFormat("libx264"),
+    ".mov": VideoFormat("libx264"),
+    # VP9 needs an explicit constant quality (crf with a zero bitrate), or ffmpeg warns and picks one.
+    ".webm": VideoFormat("libvpx-vp9", quality=None, params=("-crf", "32", "-b:v", "0")),
+    # GIF: ffmpeg's own palette (pal8), no chroma subsampling, so any size works.
+    ".gif": VideoFormat("gif", pix_fmt="pal8", quality=None),
+}
+"""The video file extensions :class:`OffscreenRecorder` writes (lower case), and their encoding."""
+
+
+def check_video_path(video: str | Path) -> VideoFormat:
+    """The encoding of ``video`` by its extension (case-insensitive).
+
+    Raises:
+        OutputError: the extension is not one of :data:`VIDEO_FORMATS` (the message lists them).
+    """
+    ext = Path(video).suffix.lower()
+    fmt = VIDEO_FORMATS.get(ext)
+    if fmt is None:
+        got = f"extension {quote(ext)}" if ext else "no extension"
+        raise OutputError(f"cannot write the video {printable(video)}: {got} is not a video format ur3hanoi writes: "
+                          f"expected one of {', '.join(VIDEO_FORMATS)}")
+    return fmt
 
 
 @dataclass(frozen=True)
@@ -24,6 +68,8 @@ class CameraConfig:
     """Offscreen camera: image size [px], frame rate [Hz], and a free camera aimed at the towers.
 
     Attributes:
+        width, height: image size [px]; videos other than GIF need even numbers (H.264/VP9 chroma subsampling).
+        fps: frames per second of sim time [Hz] (at most the control rate: the executor offers a frame per cycle).
         distance: [m] from the look-at point; azimuth, elevation: [deg], MuJoCo's free-camera convention.
     """
 
@@ -45,51 +91,89 @@ def _free_camera(station: Station, cam: CameraConfig) -> mujoco.MjvCamera:
 
 
 class OffscreenRecorder:
-    """Renders frames offscreen (``mujoco.Renderer``) into PNG files (``frames_dir``) or an MP4 (``video``).
+    """Renders frames offscreen (``mujoco.Renderer``) into PNG files (``frames_dir``) or a video file (``video``).
 
-    Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo is imported. MP4 needs
-    ``imageio`` and ``imageio-ffmpeg``; PNG needs only Pillow. Use as a context manager (it closes the renderer
-    and finishes the file).
+    Only frames whose sim time lies in ``[t_from, t_to]`` [s] are rendered (``t_to`` None: to the end); ``count``
+    is the number written. Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo is imported.
+    A video needs ``imageio-ffmpeg`` (its wheel ships ffmpeg) and an extension of :data:`VIDEO_FORMATS`; PNG needs
+    only Pillow. Use as a context manager (it closes the renderer and finishes the file).
     """
 
     def __init__(self, station: Station, model: mujoco.MjModel, frames_dir: Path | None = None,
-                 video: Path | None = None, camera: CameraConfig | None = None) -> None:
+                 video: Path | None = None, camera: CameraConfig | None = None, t_from: float = 0.0,
+                 t_to: float | None = None) -> None:
         if (frames_dir is None) == (video is None):
             raise SimulationError("give exactly one of a frames directory or a video file")
         self.cam_cfg = camera if camera is not None else CameraConfig()
-        self.fps = self.cam_cfg.fps
+        cam = self.cam_cfg
+        if not (cam.width >= 1 and cam.height >= 1 and math.isfinite(cam.fps) and cam.fps > 0):
+            raise SimulationError(f"camera {cam.width}x{cam.height} px at {cam.fps!r} Hz is invalid: expected a "
+                                  "positive size and frame rate")
+        t_end = math.inf if t_to is None else t_to
+        if not (math.isfinite(t_from) and t_from >= 0.0 and t_end > t_from):
+            raise SimulationError(f"time window [{t_from!r}, {t_to!r}] s is invalid: expected 0 <= from < to")
+        self.fps = cam.fps
+        self.t_from, self.t_to = float(t_from), t_end
         self.frames_dir, self.video = frames_dir, video
         self.count = 0
         self._writer: Any = None
+        self._video_format: VideoFormat | None = None
         if video is not None:
+            fmt = check_video_path(video)
+            if fmt.pix_fmt == "yuv420p" and (cam.width % 2 or cam.height % 2):
+                raise SimulationError(f"a {video.suffix} video of {cam.width}x{cam.height} px is invalid: expected "
+                                      "an even width and height")
             try:
-                import imageio.v2 as imageio  # optional: imageio + imageio-ffmpeg
+                import imageio_ffmpeg  # optional: the "video" extra
+
+                imageio_ffmpeg.get_ffmpeg_exe()
             except ImportError:
-                raise SimulationError(f"cannot write the video {video}: it needs the packages imageio and "
+                raise SimulationError(f"cannot write the video {printable(video)}: it needs the package "
                                       "imageio-ffmpeg (not installed); write PNG frames (frames_dir) instead") from None
+            except RuntimeError as exc:  # no ffmpeg binary found
+                raise SimulationError(f"cannot write the video {printable(video)}: {exc}") from None
+            self._video_format = fmt
             video.parent.mkdir(parents=True, exist_ok=True)
-            try:
-                self._writer = imageio.get_writer(str(video), fps=self.fps, codec="libx264", quality=7,
-                                                  macro_block_size=8)
-            except Exception as exc:  # imageio raises several types for a missing ffmpeg backend
-                raise SimulationError(f"cannot write {video}: {exc}") from None
         else:
             assert frames_dir is not None
             frames_dir.mkdir(parents=True, exist_ok=True)
+        # MuJoCo's offscreen framebuffer is the model's (640x480 unless the XML says otherwise): make it fit.
+        vis = model.vis.global_
+        vis.offwidth, vis.offheight = max(vis.offwidth, cam.width), max(vis.offheight, cam.height)
         try:
-            self.renderer = mujoco.Renderer(model, self.cam_cfg.height, self.cam_cfg.width)
+            self.renderer = mujoco.Renderer(model, cam.height, cam.width)
+        except ValueError:  # a size the framebuffer does not hold: a bug here, not a missing OpenGL
+            raise
         except Exception as exc:  # no OpenGL context: the message says which backend failed
-            if self._writer is not None:
-                self._writer.close()
             raise SimulationError(f"offscreen rendering is unavailable ({exc}); on a headless machine set "
                                   "MUJOCO_GL=egl (libegl1) or MUJOCO_GL=osmesa (libosmesa6)") from None
-        self.camera = _free_camera(station, self.cam_cfg)
+        self.camera = _free_camera(station, cam)
+
+    def _open_writer(self) -> Any:
+        """Start ffmpeg on the first frame: a run with no frame in the window leaves no (invalid) video behind."""
+        import imageio_ffmpeg
+
+        fmt, cam = self._video_format, self.cam_cfg
+        assert fmt is not None and self.video is not None
+        try:
+            writer = imageio_ffmpeg.write_frames(
+                str(self.video), (cam.width, cam.height), fps=self.fps, codec=fmt.codec, pix_fmt_out=fmt.pix_fmt,
+                quality=fmt.quality, macro_block_size=1, ffmpeg_log_level="error", output_params=list(fmt.params))
+            writer.send(None)  # starts ffmpeg
+        except Exception as exc:  # a failing ffmpeg raises several types
+            raise SimulationError(f"cannot write {printable(self.video)}: {exc}") from None
+        return writer
 
     def __call__(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        t = float(data.time)
+        if not self.t_from - 1e-9 <= t <= self.t_to + 1e-9:
+            return
         self.renderer.update_scene(data, self.camera)
         pixels = self.renderer.render()
-        if self._writer is not None:
-            self._writer.append_data(pixels)
+        if self.video is not None:
+            if self._writer is None:
+                self._writer = self._open_writer()
+            self._writer.send(np.ascontiguousarray(pixels))
         else:
             from PIL import Image
 
@@ -97,11 +181,14 @@ class OffscreenRecorder:
             Image.fromarray(pixels).save(self.frames_dir / f"frame_{self.count:05d}.png")
         self.count += 1
 
+    def _close_writer(self) -> None:
+        if self._writer is not None:
+            writer, self._writer = self._writer, None
+            writer.close()
+
     def close(self) -> None:
         self.renderer.close()
-        if self._writer is not None:
-            self._writer.close()
-            self._writer = None
+        self._close_writer()
 
     def __enter__(self) -> OffscreenRecorder:
         return self
