@@ -12,7 +12,9 @@ Modules, in order of dependency (each imports only the ones above it):
   (:class:`SuctionConfig`, :class:`SuctionCup`, :class:`GripperInput`).
 - :mod:`~ur3hanoi.sim.halt`: the motion of a halt (:class:`HaltProfile`, :data:`DEFAULT_HALT_PROFILE`: Ruckig).
 - :mod:`~ur3hanoi.sim.result`: what a run reports (:class:`SimResult`, :class:`FeedbackEvent`,
-  :class:`FinalBlock`, :class:`JointTrace`).
+  :class:`FinalBlock`, :class:`DisplacedBlock`, :class:`JointTrace`).
+- :mod:`~ur3hanoi.sim.diagnosis`: what a halt says happened: the block actually missing, a grasp the cup did not
+  reach, blocks knocked out of place after the halt (:class:`DisplacedBlock`).
 - :mod:`~ur3hanoi.sim.executor`: :func:`run_plan` streams a :class:`ur3hanoi.plan.Plan`, checks the suction like
   the lab program, halts on a fault (raising :class:`ur3hanoi.errors.SuctionFaultError` with the result) and
   verifies the final block positions (:class:`Faults`, :class:`SimConfig`).

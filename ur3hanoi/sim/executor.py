@@ -32,9 +32,10 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import SimulationError, SuctionFaultError
-from ur3hanoi.hanoi import block_colour, stacks_before_moves
+from ur3hanoi.hanoi import block_colour
 from ur3hanoi.plan import Phase, Plan, Trajectory
 from ur3hanoi.robot import JOINT_NAMES, N_JOINTS
+from ur3hanoi.sim.diagnosis import displaced_blocks, missed_grasp, missing_block
 from ur3hanoi.sim.halt import DEFAULT_HALT_PROFILE, HaltProfile
 from ur3hanoi.sim.result import DisplacedBlock, FeedbackEvent, FinalBlock, JointTrace, SimResult
 from ur3hanoi.sim.scene import SceneConfig, TaskScene, build_task_scene, slot_centers, slot_of, warning_counts
@@ -100,12 +101,6 @@ class _Fault:
     t: float
     k: int
     resting: dict[int, FloatArray] = field(default_factory=dict)
-
-
-def _slot_text(slot: tuple[int, int] | None, xyz: FloatArray) -> str:
-    if slot is None:
-        return f"in no slot at {np.round(xyz, 4).tolist()} m"
-    return f"at tower {slot[0] + 1} height {slot[1] + 1}"
 
 
 def _validate(plan: Plan, faults: Faults) -> tuple[int, int]:
@@ -295,7 +290,8 @@ class _Run:
                 what = (f"{block_colour(block)} block {block + 1} was dropped while carrying it from tower "
                         f"{move.from_tower + 1} to tower {move.to_tower + 1} {sensed}")
             else:
-                block, what = self._diagnose_missing(mv, sensed)
+                missed = missed_grasp(self.plan, mv, self.closest_grasp.get(mv), self.cfg.suction.grasp_radius)
+                block, what = missing_block(self.plan, self.scene, mv, sensed, self.cfg.place_tolerance, missed)
             msg = f"suction fault in move {mv + 1}/{len(moves)}: {what}; halted, suction off, arm returned home"
             resting = {b: self.scene.block_pos(b) for b in self.scene.block_body if kind == "missing" or b != block}
             return _Fault(mv, block, msg, fb.t, k, resting)
@@ -304,58 +300,6 @@ class _Run:
             self.events.append(FeedbackEvent(fb.t, "grasp", mv, cup.attached if cup.attached is not None else -1,
                                              fb.digin, fb.ain0))
         return None
-
-    def _diagnose_missing(self, mv: int, sensed: str) -> tuple[int, str]:
-        """Why nothing was picked in move ``mv``: the block actually missing, read from the simulation state.
-
-        The plan expects every block in the slot the moves so far put it in. A block absent from the scene, or in
-        no slot, is the missing one; in a stacked tower the blocks above a missing one rest one level lower, so
-        the block the move wanted to pick is usually not the missing one. Returns (missing block, message part).
-        """
-        moves, scene = self.plan.moves, self.scene
-        move = moves[mv]
-        n_blocks = max(m.block for m in moves) + 1
-        stacks = stacks_before_moves(moves, n_blocks, moves[0].from_tower, self.plan.station.n_towers)[mv]
-        expected = {b: (t, h) for t, stack in enumerate(stacks) for h, b in enumerate(stack)}
-        centers = slot_centers(self.plan.station)
-        absent = [b for b in sorted(expected) if b not in scene.block_body]
-        if absent == [move.block]:  # the block to pick is the one that is gone: the plain message says it all
-            return move.block, (f"{block_colour(move.block)} block {move.block + 1} is missing at tower "
-                                f"{move.from_tower + 1} height {move.from_height + 1} {sensed}")
-        displaced = []
-        for b in sorted(scene.block_body):
-            xyz = scene.block_pos(b)
-            slot = slot_of(centers, xyz, self.cfg.place_tolerance)
-            if slot != expected[b]:
-                displaced.append((b, slot, xyz))
-        missed = self._missed_grasp(mv)
-        if not absent and not displaced and missed:
-            # Every block is where the plan expects it: the cup did not reach the block (e.g. a table entry off).
-            return move.block, (f"{block_colour(move.block)} block {move.block + 1} at tower {move.from_tower + 1} "
-                                f"height {move.from_height + 1} was not grasped {sensed}: {missed}")
-        absent += [b for b, slot, _ in displaced if slot is None]
-        missing = absent[0] if absent else move.block
-        t, h = expected[missing]
-        where = f"tower {t + 1} height {h + 1}"
-        text = (f"no block to pick at tower {move.from_tower + 1} height {move.from_height + 1}, where "
-                f"{block_colour(move.block)} block {move.block + 1} should be {sensed}: ")
-        text += (f"{block_colour(missing)} block {missing + 1} is missing from {where}" if absent else
-                 f"{block_colour(missing)} block {missing + 1} is not there")
-        found = [f"{block_colour(b)} block {b + 1} is {_slot_text(slot, xyz)}" for b, slot, xyz in displaced
-                 if slot is not None]
-        return missing, text + (f" ({', '.join(found)})" if found else "")
-
-    def _missed_grasp(self, mv: int) -> str:
-        """How close the cup came to the grasp point of move ``mv``'s block in its grasp dwell, and at which
-        waypoint (the plan's segment target: a table entry for a table plan); "" when not measured."""
-        dist = self.closest_grasp.get(mv)
-        if dist is None:
-            return ""
-        target = next((s.target for s in self.plan.segments if s.phase == Phase.GRASP_DWELL and s.move_index == mv),
-                      "")
-        at = f" at {target}" if target else ""
-        return (f"the cup (suction point) came no closer than {dist * 1e3:.1f} mm to its grasp point{at} (a grasp "
-                f"needs {self.cfg.suction.grasp_radius * 1e3:g} mm or less)")
 
     # ------------------------------------------------------------------------------------------ 3. halt / settle
 
@@ -414,18 +358,6 @@ class _Run:
         return JointTrace(t=np.array(t), q_ref=q_ref, qd_ref=qd_ref, qdd_ref=qdd_ref, q=np.array(q),
                           qd=np.array(qd), halt_start=self.halt_start, settle_start=settle_start)
 
-    def displaced_blocks(self, fault: _Fault) -> list[DisplacedBlock]:
-        """The blocks that rested when ``fault`` was detected and moved farther than ``knock_tolerance`` since."""
-        out = []
-        centers = slot_centers(self.plan.station)
-        for b, before in sorted(fault.resting.items()):
-            moved = float(np.linalg.norm(self.scene.block_pos(b) - before))
-            if moved > self.cfg.knock_tolerance:
-                slot = slot_of(centers, before, self.cfg.place_tolerance)
-                out.append(DisplacedBlock(b, None if slot is None else slot[0], None if slot is None else slot[1],
-                                          moved))
-        return out
-
     def result(self, fault: _Fault | None, wall: float, settle_start: int) -> SimResult:
         """The outcome: final block positions, arm and suction state, and the status the checks give."""
         cfg, st, moves, cup = self.cfg, self.plan.station, self.plan.moves, self.cup
@@ -439,7 +371,8 @@ class _Run:
             mv, block, msg, t_det = fault.move, fault.block, fault.message, fault.t
             latency = None if self.drop_time is None else t_det - self.drop_time
             status, code, error = "halted", SuctionFaultError.exit_code, msg
-            displaced = self.displaced_blocks(fault)
+            displaced = displaced_blocks(self.plan, self.scene, fault.resting, cfg.knock_tolerance,
+                                         cfg.place_tolerance)
             if displaced:
                 error += "; final check: " + "; ".join(d.describe() for d in displaced)
             fault_tower = moves[mv].from_tower  # where the block was (missing) or came from (dropped)
