@@ -13,7 +13,7 @@ import pinocchio as pin
 import pytest
 import yaml
 
-from ur3hanoi.calibrate import RESIDUAL_WARN_MM, CalibrationFit, fit_station
+from ur3hanoi.calibrate import MIN_SUSPECT_MM, CalibrationFit, fit_station
 from ur3hanoi.cli import main
 from ur3hanoi.errors import IKError, TaughtPointsError
 from ur3hanoi.grid import ABOVE, ON, T_world_tcp
@@ -100,7 +100,7 @@ def write_taught(path: Path, taught: TaughtPoints, units: str = "deg") -> Path:
     scale = 180.0 / math.pi if units == "deg" else 1.0
     pts = []
     for p in taught.points:
-        item: dict[str, object] = {"tower": p.tower, "height": p.height}
+        item: dict[str, object] = {"tower": p.tower + 1, "height": p.height + 1}  # numbered from 1 in files
         if p.k == ABOVE:
             item["pose"] = "above"
         item["q"] = [float(v * scale) for v in p.q]
@@ -177,7 +177,7 @@ def test_one_mm_noise_stays_within_1p5_mm(real_base: Station, slots: tuple[Slot,
     errs = contact_errors_m(truth, fit.station, ks=ks)
     assert np.max(errs) < 1.5e-3, f"worst regenerated pose off by {np.max(errs) * 1e3:.3f} mm"
     # 1 mm noise never looks like a mis-recorded point.
-    assert not any("residual" in w for w in fit.warnings)
+    assert fit.suspects == () and fit.warnings == () and fit.sound
 
 
 def test_outlier_is_named_in_the_residual_report(truth: Station, truth_base: Station) -> None:
@@ -192,12 +192,15 @@ def test_outlier_is_named_in_the_residual_report(truth: Station, truth_base: Sta
     assert fit.residuals_mm[outlier] > 7.0
     flagged = [r.index for r in fit.residual_table() if r.flagged]
     assert flagged == [outlier]
+    assert fit.used == tuple(i != outlier for i in range(len(slots)))
     assert len(fit.warnings) == 1
-    assert "points[8] (tower 1 height 1 on): residual" in fit.warnings[0]
-    assert np.sort(fit.residuals_mm)[-2] < RESIDUAL_WARN_MM
-    # Without the outlier's influence the grid is still close: the other slot of tower 1 height 1 agrees.
+    assert fit.warnings[0].startswith("tower 2 height 2 on [points[8]]: ")
+    assert "mm from the grid fitted to the other 17 contacts and 18 above poses" in fit.warnings[0]
+    assert np.sort(fit.residuals_mm)[-2] < MIN_SUSPECT_MM
+    # The outlier has no influence: the fit is the one without it, and the grid is close to the truth.
     clean = fit_station(base, TaughtPoints(tuple(p for p in taught.points if p.index != outlier), "<t>", ""))
-    assert np.max(contact_errors_m(truth, clean.station)) < 0.5e-3
+    np.testing.assert_allclose(fit.station.tower_origins, clean.station.tower_origins, atol=1e-12)
+    assert np.max(contact_errors_m(truth, fit.station)) < 0.5e-3
 
 
 def test_residual_table_rows_match_points(truth: Station, truth_base: Station) -> None:
@@ -224,7 +227,9 @@ def test_yaw_is_the_circular_mean_and_deviations_warn(truth: Station, truth_base
     assert math.degrees(float(np.angle(np.exp(1j * (fit.station.tool_yaw - truth.tool_yaw))))) == pytest.approx(
         0.0, abs=1e-2)
     assert fit.yaw_dev_deg[:2] == pytest.approx([3.0 - 0.0, -3.0], abs=0.05)
-    assert sum("tool heading" in w for w in fit.warnings) == 2
+    # Both are suspect, but the grid needs them (one point per tower): kept, and the fit is still sound.
+    assert [s.index for s in fit.suspects] in ([0, 1], [1, 0]) and fit.used == (True, True, True) and fit.sound
+    assert sum("heading +3.0 deg" in w or "heading -3.0 deg" in w for w in fit.warnings) == 2
 
 
 def test_flat_layout_default_step_turns_with_the_tower_row() -> None:
@@ -259,7 +264,7 @@ def test_from_table_round_trip_real_pos(real_base: Station) -> None:
 
 def test_underdetermined_points_are_refused(truth: Station, truth_base: Station) -> None:
     only_above = [(t, 0, ABOVE) for t in range(3)]
-    with pytest.raises(TaughtPointsError, match="do not determine the grid"):
+    with pytest.raises(TaughtPointsError, match=r"too little left to fit the grid: .*tower\(s\) 1, 2, 3 have none"):
         fit_station(truth_base, teach(truth, only_above))
 
 
@@ -276,7 +281,7 @@ def test_cli_calibrate_then_tables_end_to_end(truth: Station, truth_base: Statio
     rc, stdout, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(base_file), "-o", str(out)],
                               capsys)
     assert rc == 0, err
-    assert "wrote" in stdout and "0 warning(s)" in stdout
+    assert "wrote" in stdout and "0 suspect(s)" in stdout
     text = out.read_text()
     assert hashlib.sha256(taught_file.read_bytes()).hexdigest() in text.splitlines()[1]
     assert hashlib.sha256(base_file.read_bytes()).hexdigest() in text.splitlines()[2]
@@ -310,7 +315,7 @@ def test_cli_from_table_round_trip(tmp_path: Path, capsys: pytest.CaptureFixture
     rc, stdout, err = run_cli(["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos",
                                "--base", str(LAB_REAL), "-o", str(out)], capsys)
     assert rc == 0, err
-    assert "from 18 points" in stdout
+    assert "from 18 of 18 points" in stdout
     st = load_station(out)
     np.testing.assert_allclose(st.tower_origins, real_base.tower_origins, atol=1e-6)
     np.testing.assert_allclose(st.height_step, real_base.height_step, atol=1e-6)
@@ -326,8 +331,8 @@ def test_cli_prints_outlier_warning(truth: Station, truth_base: Station, tmp_pat
     rc, _, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(base_file),
                           "-o", str(tmp_path / "o.yaml")], capsys)
     assert rc == 0
-    assert "ur3hanoi: warning: points[3] (tower 0 height 1 above): residual" in err
-    assert err.count("residual") == 1
+    assert "ur3hanoi: warning: tower 1 height 2 above [points[3]]: 10.0 mm from the grid fitted to" in err
+    assert err.count("ur3hanoi: warning:") == 1
 
 
 def _tilted_q(truth: Station) -> list[float]:
@@ -337,29 +342,32 @@ def _tilted_q(truth: Station) -> list[float]:
 
 BAD_INPUTS = {
     # name: (taught-file text or None for a missing file, message fragment)
-    "missing-tower": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0}\n- {tower: 1, height: 0, q: Q1}\n",
-                      "tower 2 has no taught point (towers taught: [0, 1]"),
-    "joint-count": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0}\n"
-                    "- {tower: 1, height: 0, q: [1, 2, 3, 4, 5]}\n",
+    "missing-tower": ("units: deg\npoints:\n- {tower: 1, height: 1, q: Q0}\n- {tower: 2, height: 1, q: Q1}\n",
+                      "too little left to fit the grid: it needs a usable contact ('on') pose on every tower (3 "
+                      "towers), and above poses count only on towers that also have one; tower(s) 3 have none"),
+    "joint-count": ("units: deg\npoints:\n- {tower: 1, height: 1, q: Q0}\n"
+                    "- {tower: 2, height: 1, q: [1, 2, 3, 4, 5]}\n",
                     "field 'points[1].q' = [1, 2, 3, 4, 5] is invalid: expected a list of 6 numbers"),
-    "degrees-as-rad": ("units: rad\npoints:\n- {tower: 0, height: 0, q: Q0}\n", "looks like degrees"),
-    "radians-as-deg": ("units: deg\npoints:\n- {tower: 0, height: 0, q: [2.1, -1.5, 1.6, -1.6, -1.6, 0.5]}\n",
+    "degrees-as-rad": ("units: rad\npoints:\n- {tower: 1, height: 1, q: Q0}\n", "looks like degrees"),
+    "radians-as-deg": ("units: deg\npoints:\n- {tower: 1, height: 1, q: [2.1, -1.5, 1.6, -1.6, -1.6, 0.5]}\n",
                        "looks like radians"),
-    "tilted": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0}\n- {tower: 1, height: 0, q: QT}\n"
-               "- {tower: 2, height: 0, q: Q2}\n", "points[1] (tower 1 height 0 on): the tool is tilted 20.0 deg"),
-    "unknown-units": ("units: grad\npoints:\n- {tower: 0, height: 0, q: Q0}\n",
+    "tilted": ("units: deg\npoints:\n- {tower: 1, height: 1, q: Q0}\n- {tower: 2, height: 1, q: QT}\n"
+               "- {tower: 3, height: 1, q: Q2}\n",
+               "tower(s) 2 have none (left out: points[1] (tower 2 height 1 on): the tool is tilted 20.0 deg"),
+    "unknown-units": ("units: grad\npoints:\n- {tower: 1, height: 1, q: Q0}\n",
                       "field 'units' = 'grad' is invalid: expected one of deg, rad"),
-    "missing-units": ("points:\n- {tower: 0, height: 0, q: Q0}\n", "field 'units' is missing: expected one of deg"),
-    "tower-outside": ("units: deg\npoints:\n- {tower: 3, height: 0, q: Q0}\n",
-                      "tower 3 is outside the base calibration's grid (towers 0..2"),
-    "height-outside": ("units: deg\npoints:\n- {tower: 0, height: 3, q: Q0}\n",
-                       "height 3 is outside the base calibration's grid (heights 0..2"),
-    "bad-pose": ("units: deg\npoints:\n- {tower: 0, height: 0, pose: over, q: Q0}\n",
+    "missing-units": ("points:\n- {tower: 1, height: 1, q: Q0}\n", "field 'units' is missing: expected one of deg"),
+    "tower-outside": ("units: deg\npoints:\n- {tower: 4, height: 1, q: Q0}\n",
+                      "(left out: points[0] (tower 4 height 1 on): tower 4 is outside the base calibration's grid "
+                      "(towers 1..3"),
+    "height-outside": ("units: deg\npoints:\n- {tower: 1, height: 4, q: Q0}\n",
+                       "height 4 is outside the base calibration's grid (heights 1..3"),
+    "bad-pose": ("units: deg\npoints:\n- {tower: 1, height: 1, pose: over, q: Q0}\n",
                  "field 'points[0].pose' = 'over' is invalid: expected one of on, above"),
     "not-a-list": ("units: deg\npoints: 3\n", "field 'points' = 3 is invalid"),
-    "typo-height": ("units: deg\npoints:\n- {tower: 0, hieght: 0, q: Q0}\n",
+    "typo-height": ("units: deg\npoints:\n- {tower: 1, hieght: 1, q: Q0}\n",
                     "field 'points[0].hieght' is unknown: did you mean 'points[0].height'?"),
-    "duplicate-q": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0, q: Q1}\n", "duplicate key 'q'"),
+    "duplicate-q": ("units: deg\npoints:\n- {tower: 1, height: 1, q: Q0, q: Q1}\n", "duplicate key 'q'"),
     "utf16": (None, "is UTF-16 text: save the taught-points file as UTF-8"),
     "malformed-yaml": ("units: deg\npoints: [\n", "not valid YAML"),
     "missing-file": (None, "cannot read the taught-points file (No such file or directory)"),
@@ -414,7 +422,7 @@ def test_cli_error_leaves_existing_output_untouched(tmp_path: Path, capsys: pyte
     out = tmp_path / "out.yaml"
     out.write_text("previous\n")
     taught_file = tmp_path / "t.yaml"
-    taught_file.write_text("units: rad\npoints:\n- {tower: 0, height: 0, q: [120, -90, 90, -90, -90, 0]}\n")
+    taught_file.write_text("units: rad\npoints:\n- {tower: 1, height: 1, q: [120, -90, 90, -90, -90, 0]}\n")
     rc, _, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(LAB_REAL), "-o", str(out)],
                          capsys)
     assert rc == 2 and "looks like degrees" in err

@@ -3,7 +3,21 @@
 File format (the course's): top-level keys ``sim_pos`` / ``real_pos``, each ``Q[tower][height][k]`` with six joint
 angles [rad] (controller convention), ``k = 0`` the contact ("on") pose and ``k = 1`` the pose above it; plus
 ``block_xy_pos[tower][height] = [x, y]`` [m, world] for the flat simulator layout. Any other key, a key given twice,
-or a value of the wrong shape or range is refused (:data:`LAB_FILE_SCHEMA`).
+or a value of the wrong shape or range is refused (:data:`LAB_FILE_SCHEMA`). The list indices are 0-based, as the
+lab defines them; everything ur3hanoi shows people numbers towers and heights from 1 (``Q[0][2][1]`` is "tower 1
+height 3 above").
+
+Tables recorded by hand are often incomplete, and the schema accepts what students write:
+
+- a missing entry: ``null`` for a pose (``Q[t][h][k]``), a slot (``Q[t][h]``) or a whole tower (``Q[t]``);
+- a slot with only its contact pose, ``Q[t][h] = [on]`` (the "above" pose left out);
+- one "above" pose shared by the heights of a tower: the same six numbers in ``Q[t][h][1]`` for several ``h``
+  (copied, or one YAML anchor ``&above_A`` used through aliases ``*above_A``). Shared means bit-identical values in
+  one tower; the file is represented as it is (one entry per slot) and :attr:`RecordedTable.shared_above` names
+  the groups.
+
+:func:`read_recorded_table` returns what is present (:class:`RecordedTable`, a masked array); :func:`read_table` is
+for consumers that need every entry and refuses an incomplete table, naming the missing entries.
 
 Writing (:func:`write_table`) replaces only the keys it generates: every other key keeps its exact text, the bytes
 are a pure function of the inputs, and the read-modify-write holds a lock and ends in an atomic replace
@@ -20,13 +34,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ur3hanoi import __version__
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import TableError, printable, quote
 from ur3hanoi.grid import block_xy_pos
 from ur3hanoi.io.atomic import locked_output
-from ur3hanoi.io.schema import Field, ListOf, Number, Record, Spec, Vector
+from ur3hanoi.io.schema import Field, ListOf, Nullable, Number, Record, Spec, Vector
 from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file, parse_yaml
 from ur3hanoi.resources import station_file
@@ -40,10 +55,13 @@ WHAT = "lab table file"
 
 JOINT_ANGLE = Number(-2 * math.pi, 2 * math.pi, unit="rad", what="a joint angle")
 Q_SCHEMA: Spec = ListOf(
-    ListOf(ListOf(Vector(N_JOINTS, JOINT_ANGLE), 2, 2, what="poses [on, above]"), 1, MAX_HEIGHTS, what="heights"),
+    Nullable(ListOf(
+        Nullable(ListOf(Nullable(Vector(N_JOINTS, JOINT_ANGLE)), 1, 2, what="poses [on, above]")),
+        1, MAX_HEIGHTS, what="heights")),
     1, MAX_TOWERS, what="towers",
 )
-"""``Q[tower][height][k]``: 1..10 towers of 1..20 heights of [on, above] poses of 6 joint angles [rad]."""
+"""``Q[tower][height][k]``: 1..10 towers of 1..20 heights of [on, above] poses of 6 joint angles [rad]; a tower,
+a slot or a pose may be ``null`` (not recorded) and a slot may hold only ``[on]``."""
 
 BLOCK_XY_SCHEMA: Spec = ListOf(
     ListOf(Vector(2, Number(-10.0, 10.0, unit="m", what="a coordinate")), 1, MAX_HEIGHTS, what="heights"),
@@ -81,12 +99,16 @@ def _validate(data: Any, source: str) -> dict[str, Any]:
     return dict(data)
 
 
-def _check_rectangular(value: list[list[Any]], source: str, key: str) -> None:
-    n_h = len(value[0])
-    for t, tower in enumerate(value):
-        if len(tower) != n_h:
+def _check_rectangular(value: list[Any], source: str, key: str) -> None:
+    towers = [(t, tower) for t, tower in enumerate(value) if tower is not None]
+    if not towers:
+        return
+    t0, first = towers[0]
+    for t, tower in towers[1:]:
+        if len(tower) != len(first):
             raise TableError.invalid(source, f"{key}[{t}]", tower,
-                                     f"{n_h} heights like {key}[0] (every tower has the same number of heights)")
+                                     f"{len(first)} heights like {key}[{t0}] (every tower has the same number of "
+                                     "heights)")
 
 
 def read_lab_file(path: str | Path, source: str | None = None) -> LabFile:
@@ -101,17 +123,131 @@ def read_lab_file(path: str | Path, source: str | None = None) -> LabFile:
 
 
 def parse_q(value: Any, source: str, key: str) -> FloatArray:
-    """Validate ``value`` as ``Q[tower][height][k][6]`` (field ``key`` of ``source``); shape (T, H, 2, 6) [rad]."""
+    """Validate ``value`` as a complete ``Q[tower][height][k][6]`` (field ``key`` of ``source``); shape (T, H, 2, 6)
+    [rad].
+
+    Raises:
+        TableError: invalid, or some entry is missing (the message names them).
+    """
     validate_schema(value, Q_SCHEMA, source, TableError, path=key)
     _check_rectangular(value, source, key)
-    return np.array(value, dtype=float)
+    return _recorded(value, source, key, "").full()
+
+
+Slot = tuple[int, int, int]
+"""``(tower, height, k)``: 0-based indices into ``Q``."""
+
+
+@dataclass(frozen=True)
+class RecordedTable:
+    """The entries of one table key as recorded, missing ones included.
+
+    Attributes:
+        q: joint angles [rad], shape (T, H, 2, 6), NaN where an entry is missing.
+        present: shape (T, H, 2), True where ``Q[t][h][k]`` holds a pose.
+        shared_above: groups of heights of one tower holding the same "above" pose (bit-identical values), as
+            ``(tower, (h0, h1, ...))`` with at least two heights; 0-based.
+        source: ``"<file>:<key>"``, used in messages.
+        key: the table key.
+        sha256: hex digest of the file's bytes ("" if not read from a file).
+    """
+
+    q: FloatArray
+    present: npt.NDArray[np.bool_]
+    shared_above: tuple[tuple[int, tuple[int, ...]], ...]
+    source: str
+    key: str
+    sha256: str
+
+    @property
+    def n_towers(self) -> int:
+        return int(self.q.shape[0])
+
+    @property
+    def n_heights(self) -> int:
+        return int(self.q.shape[1])
+
+    @property
+    def missing(self) -> tuple[Slot, ...]:
+        """The missing entries ``(tower, height, k)``, in ``Q`` order."""
+        return tuple((int(t), int(h), int(k)) for t, h, k in np.argwhere(~self.present))
+
+    def shared_with(self, tower: int, height: int) -> tuple[int, ...]:
+        """The heights whose "above" pose is the one of ``(tower, height)`` (itself included), or ``()``."""
+        for t, heights in self.shared_above:
+            if t == tower and height in heights:
+                return heights
+        return ()
+
+    def full(self) -> FloatArray:
+        """``q`` when every entry is present.
+
+        Raises:
+            TableError: some entries are missing; the message names them.
+        """
+        missing = self.missing
+        if missing:
+            names = ", ".join(pose_label(*slot) for slot in missing[:_MAX_NAMED])
+            more = f" and {len(missing) - _MAX_NAMED} more" if len(missing) > _MAX_NAMED else ""
+            raise TableError(f"{printable(self.source)}: {len(missing)} of {self.present.size} entries are missing "
+                             f"({names}{more}): this needs a complete table, [on, above] for every "
+                             f"{self.key}[tower][height]")
+        return self.q
+
+
+_MAX_NAMED = 6  # missing entries named in a message; the rest are counted
+
+
+def _recorded(value: list[Any], source: str, key: str, sha256: str) -> RecordedTable:
+    """A validated, rectangular ``Q`` (with nulls) as a :class:`RecordedTable`."""
+    n_h = next((len(tower) for tower in value if tower is not None), 0)
+    if n_h == 0:
+        raise TableError(f"{printable(source)}: field '{key}' holds no entry (every tower is null): nothing to use")
+    q = np.full((len(value), n_h, 2, N_JOINTS), np.nan)
+    for t, tower in enumerate(value):
+        for h, slot in enumerate(tower or ()):
+            for k, pose in enumerate(slot or ()):
+                if pose is not None:
+                    q[t, h, k] = pose
+    present = ~np.isnan(q).any(axis=3)
+    groups: list[tuple[int, tuple[int, ...]]] = []
+    for t in range(q.shape[0]):
+        seen: list[int] = []
+        for h in range(n_h):
+            if not present[t, h, 1] or h in seen:
+                continue
+            same = tuple(h2 for h2 in range(h, n_h) if present[t, h2, 1] and np.array_equal(q[t, h2, 1], q[t, h, 1]))
+            seen.extend(same)
+            if len(same) > 1:
+                groups.append((t, same))
+    return RecordedTable(q=q, present=present, shared_above=tuple(groups), source=f"{source}:{key}", key=key,
+                         sha256=sha256)
+
+
+def read_recorded_table(path: str | Path, key: str) -> RecordedTable:
+    """The entries of ``key`` present in a lab table file, missing and shared ones marked (see the module
+    docstring).
+
+    Raises:
+        TableError: the file is invalid (see :func:`read_lab_file`), has no ``key``, or the key holds no entry.
+    """
+    return recorded_table_of(read_lab_file(path), path, key)
+
+
+def recorded_table_of(lab: LabFile, path: str | Path, key: str) -> RecordedTable:
+    """:func:`read_recorded_table` of an already read :class:`LabFile` (read from ``path``)."""
+    _check_key(key)
+    if key not in lab.data:
+        present = ", ".join(k for k in lab.data if k in TABLE_KEYS) or "none"
+        raise TableError(f"{printable(path)}: key '{key}' not found (table keys present: {present})")
+    return _recorded(lab.data[key], str(path), key, lab.sha256)
 
 
 def read_table(path: str | Path, key: str) -> FloatArray:
-    """``Q`` of ``key`` in a lab table file as an array (T, H, 2, 6) [rad].
+    """``Q`` of ``key`` in a lab table file as an array (T, H, 2, 6) [rad]; every entry must be present.
 
     Raises:
-        TableError: the file is invalid (see :func:`read_lab_file`) or has no ``key``.
+        TableError: the file is invalid (see :func:`read_lab_file`), has no ``key``, or misses entries (named).
     """
     return table_of(read_lab_file(path), path, key)
 
@@ -122,12 +258,9 @@ def _check_key(key: str) -> None:
 
 
 def table_of(lab: LabFile, path: str | Path, key: str) -> FloatArray:
-    """``Q`` of ``key`` in an already read :class:`LabFile` (read from ``path``)."""
-    _check_key(key)
-    if key not in lab.data:
-        present = ", ".join(k for k in lab.data if k in TABLE_KEYS) or "none"
-        raise TableError(f"{printable(path)}: key '{key}' not found (table keys present: {present})")
-    return np.array(lab.data[key], dtype=float)
+    """The complete ``Q`` of ``key`` in an already read :class:`LabFile` (read from ``path``); see
+    :func:`read_table`."""
+    return recorded_table_of(lab, path, key).full()
 
 
 # ---------------------------------------------------------------------------------------------------- writing
@@ -157,7 +290,7 @@ def format_xy(xy: Sequence[Sequence[Sequence[float]]]) -> str:
             prefix = "- " if h == 0 else "  "
             # Rounded to 1e-10 m: exact enough, and reads 0.3 rather than 0.30000000000000004.
             x, y = (round(float(v), 10) for v in p[:2])
-            lines.append(f"{prefix}- [{_num(x)}, {_num(y)}]  # tower {t} height {h} [m, world]")
+            lines.append(f"{prefix}- [{_num(x)}, {_num(y)}]  # tower {t + 1} height {h + 1} [m, world]")
     return "\n".join(lines) + "\n"
 
 
@@ -290,11 +423,15 @@ __all__ = [
     "LAB_FILE_SCHEMA",
     "TABLE_KEYS",
     "LabFile",
+    "RecordedTable",
+    "Slot",
     "format_q",
     "format_xy",
     "parse_q",
     "read_lab_file",
+    "read_recorded_table",
     "read_table",
+    "recorded_table_of",
     "splice_yaml",
     "table_of",
     "write_table",
