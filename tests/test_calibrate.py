@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import replace
@@ -24,6 +25,7 @@ from ur3hanoi.station import Station, load_station, station_to_dict
 from ur3hanoi.taught import TaughtPoint, TaughtPoints, taught_from_table
 from ur3hanoi.waypoints import generate_table
 
+from . import recorded_tables as rt
 from .conftest import LAB_REAL, LAB_SIM, REPO
 
 Slot = tuple[int, int, int]  # (tower, height, k)
@@ -353,7 +355,7 @@ BAD_INPUTS = {
                        "looks like radians"),
     "tilted": ("units: deg\npoints:\n- {tower: 1, height: 1, q: Q0}\n- {tower: 2, height: 1, q: QT}\n"
                "- {tower: 3, height: 1, q: Q2}\n",
-               "tower(s) 2 have none (left out: points[1] (tower 2 height 1 on): the tool is tilted 20.0 deg"),
+               "tower(s) 2 have none (left out: points[1] (tower 2 height 1 on): the tool is tilted 20.00 deg"),
     "unknown-units": ("units: grad\npoints:\n- {tower: 1, height: 1, q: Q0}\n",
                       "field 'units' = 'grad' is invalid: expected one of deg, rad"),
     "missing-units": ("points:\n- {tower: 1, height: 1, q: Q0}\n", "field 'units' is missing: expected one of deg"),
@@ -428,3 +430,81 @@ def test_cli_error_leaves_existing_output_untouched(tmp_path: Path, capsys: pyte
     assert rc == 2 and "looks like degrees" in err
     assert out.read_text() == "previous\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.yaml", "t.yaml"]
+
+
+# ------------------------------------------------------------------------------------- gross errors, robustly
+
+GROSS = {
+    "typo10": lambda q: (rt.typo(q, (1, 2, ON), 1, 10.0), ["tower 2 height 3 on", "likely a typo in joint 2"]),
+    "duplicated": lambda q: (rt.duplicate(q, (0, 0, ON), (0, 1, ON)), ["tower 1 height 2 on", "a copied entry"]),
+    "swapped-heights": lambda q: (rt.swap(q, (2, 0, ON), (2, 2, ON)), ["tower 3 height 1 on", "swapped heights"]),
+    "swapped-towers": lambda q: (rt.swap(q, (0, 1, ON), (1, 1, ON)), ["height 2 on", "swapped towers"]),
+}
+
+
+@pytest.mark.parametrize("contact_only", [False, True], ids=["full", "contact-only"])
+@pytest.mark.parametrize("kind", sorted(GROSS))
+def test_cli_from_table_never_aborts_on_a_gross_error(kind: str, contact_only: bool, truth: Station,
+                                                      truth_base: Station, tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    base_file = write_base(tmp_path / "base.yaml", truth_base)
+    q, said = GROSS[kind](rt.recorded_q(truth, np.random.default_rng(len(kind))))
+    table = rt.write_table(tmp_path / "hand.yaml", "real_pos", rt.table_doc(q, contact_only=contact_only))
+    out = tmp_path / "station.yaml"
+    rc, stdout, err = run_cli(["calibrate", "--from-table", str(table), "--key", "real_pos", "--base", str(base_file),
+                               "-o", str(out)], capsys)
+    assert rc == 0, err
+    first = err.splitlines()[0]
+    assert first.startswith("ur3hanoi: warning: ") and all(s in first for s in said), err
+    assert "suspects, worst first:" in stdout and "# left out (suspect): real_pos[" in out.read_text()
+    # The station of the remaining entries is within the noise of the truth.
+    assert np.max(contact_errors_m(truth, load_station(out))) < rt.NOISE_MM[1] * 1e-3
+
+
+def test_cli_taught_points_with_swapped_labels(truth: Station, truth_base: Station, tmp_path: Path,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    taught = teach(truth, FULL, np.random.default_rng(30), noise_m=0.001)
+    pts = list(taught.points)
+    # Heights 1 and 3 of tower 2's contact written the wrong way round.
+    pts[6], pts[10] = replace(pts[6], q=pts[10].q), replace(pts[10], q=pts[6].q)
+    taught_file = write_taught(tmp_path / "taught.yaml", TaughtPoints(tuple(pts), "<t>", ""))
+    base_file = write_base(tmp_path / "base.yaml", truth_base)
+    rc, _, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(base_file), "-o",
+                          str(tmp_path / "o.yaml")], capsys)
+    assert rc == 0, err
+    warnings = err.splitlines()[:2]
+    assert sorted(w.split(" [")[0] for w in warnings) == ["ur3hanoi: warning: tower 2 height 1 on",
+                                                           "ur3hanoi: warning: tower 2 height 3 on"]
+    assert all("swapped heights with points[" in w for w in warnings)
+
+
+def test_a_tilted_point_is_left_out_not_a_reason_to_stop(truth: Station, truth_base: Station) -> None:
+    taught = teach(truth, FULL)
+    pts = list(taught.points)
+    pts[4] = replace(pts[4], q=tuple(math.radians(v) for v in _tilted_q(truth)))
+    fit = fit_station(truth_base, pts)
+    assert fit.sound and [s.index for s in fit.suspects] == [4] and not fit.used[4]
+    assert fit.suspects[0].reason.endswith("the tool is tilted 20.00 deg from pointing down (more than 10 deg: left "
+                                           "out of the fit)")
+
+
+def test_cli_unsound_fit_writes_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # The stacked real_pos table with the flat simulator's base: the fitted step is not a flat layout's.
+    out = tmp_path / "o.yaml"
+    rc, stdout, err = run_cli(["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos", "--base", "lab_sim",
+                               "-o", str(out)], capsys)
+    assert rc == 2 and not out.exists()
+    assert err.count("\n") == 1 and "the fit is not sound, nothing written: the fitted grid is invalid" in err
+    assert "reference: grid fitted" in stdout
+
+
+def test_cli_calibrate_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "o.yaml"
+    rc, stdout, err = run_cli(["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos", "--base",
+                               str(LAB_REAL), "-o", str(out), "--json"], capsys)
+    assert rc == 0 and out.exists()
+    doc = json.loads(stdout)
+    assert set(doc) == {"entries", "suspects", "fit"} and doc["suspects"] == []
+    assert len(doc["entries"]) == 18 and doc["entries"][0]["field"] == "real_pos[0][0][0]"
+    assert doc["fit"]["points_used"] == 18 and doc["fit"]["rms_mm"] < 1e-6
+    assert err.startswith(f"wrote {out}: fitted ")

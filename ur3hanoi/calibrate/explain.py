@@ -169,13 +169,18 @@ def duplicates(slots: Sequence[Slot], qs: Sequence[Sequence[float]], shared: Seq
 
 
 def diagnose(robot: Ur3Model, T_world_base: pin.SE3, slots: Sequence[Slot], qs: Sequence[Sequence[float]],
-             p_world: FloatArray, targets: FloatArray, grid_points: dict[Slot, FloatArray], suspects: Sequence[int],
-             yaw: float, tol_mm: float, tol_deg: float, labels: Sequence[str]) -> dict[int, str]:
+             p_world: FloatArray, rot_deg: FloatArray, targets: FloatArray, grid_points: dict[Slot, FloatArray],
+             suspects: Sequence[int], yaw: float, tol_mm: float, tol_deg: float, labels: Sequence[str]
+             ) -> dict[int, str]:
     """What probably happened to each suspect: copied, swapped, recorded in the wrong slot, a typo in one joint.
+
+    A pose recorded in the wrong slot keeps the grid's tool orientation; when both a wrong slot and a typo in one
+    joint explain a deviation, the one leaving the smaller normalized error is given.
 
     Args:
         robot, T_world_base: the robot model and its base pose in world.
         slots, qs, p_world: every gridded point's slot, joint values [rad] and measured suction point [m, world].
+        rot_deg: each point's orientation error from the grid pose [deg].
         targets: each point's grid suction point [m, world], shape (N, 3).
         grid_points: the grid's suction point of every slot.
         suspects: indices of the points to explain.
@@ -197,9 +202,13 @@ def diagnose(robot: Ur3Model, T_world_base: pin.SE3, slots: Sequence[Slot], qs: 
         else:
             slot, d = nearest_slot(p_world[i], grid_points)
             typo = joint_typo(robot, T_world_base, qs[i], targets[i], yaw, tol_mm, tol_deg)
-            if slot != slots[i] and d <= tol_mm:
+            misplaced = slot != slots[i] and d <= tol_mm and rot_deg[i] <= tol_deg
+            cost_slot = (d / tol_mm) ** 2 + (rot_deg[i] / tol_deg) ** 2
+            typo_fits = typo is not None and typo.explains
+            cost_typo = (typo.residual_mm / tol_mm) ** 2 + (typo.residual_deg / tol_deg) ** 2 if typo else math.inf
+            if misplaced and not (typo_fits and cost_typo < cost_slot):
                 out[i] = f"it fits {pose_label(*slot)} ({d:.1f} mm): recorded in the wrong slot?"
-            elif typo is not None and typo.explains:
+            elif typo is not None and typo_fits:
                 out[i] = f"likely {typo.describe()}"
             else:
                 out[i] = "not explained by a typo in one joint: re-record it"

@@ -199,8 +199,8 @@ def _hard_problems(base: Station, points: Sequence[TaughtPoint], m: Measured) ->
             out.append(f"joint angles {np.round(np.degrees(p.q), 3).tolist()} deg are outside the joint limits of "
                        f"{printable(base.source)}")
         elif m.tilt_deg[i] > MAX_TILT_DEG:
-            out.append(f"the tool is tilted {m.tilt_deg[i]:.1f} deg from pointing down (at most {MAX_TILT_DEG:g} deg "
-                       f"to be used): not a pick pose, or a wrong tool offset in {printable(base.source)}")
+            out.append(f"the tool is tilted {m.tilt_deg[i]:.2f} deg from pointing down (more than "
+                       f"{MAX_TILT_DEG:g} deg: left out of the fit)")
         else:
             out.append("")
     return out
@@ -219,6 +219,8 @@ def _underdetermined(where: str, base: Station, points: Sequence[TaughtPoint], c
     if left_out:
         more = f" and {len(left_out) - 2} more" if len(left_out) > 2 else ""
         need += f" (left out: {'; '.join(left_out[:2])}{more})"
+    if sum("tilted" in h for h in hard) > len(points) // 2:
+        need += f"; most poses are tilted: is the tool offset of {printable(base.source)} right?"
     return _fail(where, need)
 
 
@@ -287,16 +289,17 @@ def _reasons(ctx: _Context, suspects: Sequence[int]) -> dict[int, str]:
     slots = [(p.tower, p.height, p.k) for p in pts]
     where = {g: n for n, g in enumerate(gridded)}
     what = diagnose(load_ur3(ctx.base.tool, ctx.base.limits), ctx.base.T_world_base, [slots[i] for i in gridded],
-                    [pts[i].q for i in gridded], m.p_world[gridded], ctx.fitted[gridded], ctx.grid_points,
+                    [pts[i].q for i in gridded], m.p_world[gridded], ctx.fit.rot_deg[gridded], ctx.fitted[gridded],
+                    ctx.grid_points,
                     [where[i] for i in suspects if i in where], ctx.fit.yaw, th.mm, th.deg,
                     [f"{pts[i].label}" for i in gridded])
     out: dict[int, str] = {}
     for i in suspects:
         p = pts[i]
-        parts = [ctx.hard[i]] if ctx.hard[i] else []
         if np.isnan(ctx.fitted[i]).any():
-            out[i] = "; ".join(parts)
+            out[i] = ctx.hard[i]
             continue
+        parts = []
         dev = float(np.linalg.norm(m.p_world[i] - ctx.fitted[i])) * 1e3
         if ctx.shared[i]:
             heights = ", ".join(str(h + 1) for h in p.shared)
@@ -307,12 +310,14 @@ def _reasons(ctx: _Context, suspects: Sequence[int]) -> dict[int, str]:
                          "this one)")
         else:
             parts.append(f"{dev:.1f} mm from the grid fitted to {_basis(pts, ctx.fit.used, i)}")
-        if ctx.fit.rot_deg[i] > th.deg:
+        if ctx.fit.rot_deg[i] > th.deg and m.tilt_deg[i] <= MAX_TILT_DEG:
             yaw_dev = math.degrees(float(wrap_angle(m.heading[i] - ctx.fit.yaw)))
             parts.append(f"the tool is turned {ctx.fit.rot_deg[i]:.1f} deg from the grid pose (tilt "
                          f"{m.tilt_deg[i]:.1f} deg, heading {yaw_dev:+.1f} deg)")
         if i in where:
             parts.append(what[where[i]])
+        if ctx.hard[i]:
+            parts.append(ctx.hard[i])
         out[i] = "; ".join(parts)
     return out
 
