@@ -67,3 +67,40 @@ def test_swaps_duplicates_and_the_nearest_slot() -> None:
     qs = [[1.0] * 6, [2.0] * 6, [1.0] * 6, [1.0] * 6]
     assert duplicates(slots, qs, [False] * 4) == {0: 2, 2: 0, 3: 0}
     assert duplicates(slots, qs, [False, False, True, False]) == {0: 3, 3: 0}
+
+
+def test_joint_typo_uses_the_position_when_the_heading_was_recorded_sloppily(lab_real: Station) -> None:
+    # The pose was taught 1.5 deg off in heading (about the tool axis, suction point in place), then joint 1 was
+    # mistyped by 10 deg: the heading alone would misplace the joint value by 1.5 deg; weighing in the suction
+    # point's position (lever 0.3 m about joint 1) brings it within half a degree.
+    import pinocchio as pin
+
+    from ur3hanoi.ik import make_solver, solve_on_branch
+
+    target = T_world_tcp(lab_real, 1, 1, ON)
+    turned = pin.SE3(target.rotation @ pin.utils.rotate("z", math.radians(1.5)), target.translation)
+    solver = make_solver("pinocchio", load_ur3(lab_real.tool, lab_real.limits))
+    q = solve_on_branch(solver, lab_real.T_world_base.actInv(turned), lab_real.q_home_array).q
+    typo_q = q.copy()
+    typo_q[0] += math.radians(10.0)
+    found = joint_typo(load_ur3(lab_real.tool, lab_real.limits), lab_real.T_world_base, typo_q, target.translation,
+                       lab_real.tool_yaw, tol_mm=6.0, tol_deg=2.0)
+    assert found is not None and found.joint == 0 and found.explains
+    assert math.degrees(found.predicted - q[0]) == pytest.approx(0.0, abs=0.6)
+
+
+def test_a_pose_in_the_wrong_slot_keeps_the_grid_orientation(lab_real: Station) -> None:
+    from ur3hanoi.calibrate.explain import diagnose
+
+    grid = {(t, h, k): T_world_tcp(lab_real, t, h, k).translation for t in range(3) for h in range(3)
+            for k in (ON, ABOVE)}
+    slots = [(0, 0, ON), (0, 1, ON)]
+    q = rt.recorded_q(lab_real, None)
+    qs = [q[0, 0, ON], q[0, 2, ON]]  # height 2's entry holds height 3's pose
+    p = np.array([grid[(0, 0, ON)], grid[(0, 2, ON)]])
+    args = (load_ur3(lab_real.tool, lab_real.limits), lab_real.T_world_base, slots, qs, p)
+    rest = (np.array([grid[s] for s in slots]), grid, [1], lab_real.tool_yaw, 3.0, 2.0, ["a", "b"])
+    assert diagnose(*args, np.array([0.0, 0.1]), *rest)[1] == "it fits tower 1 height 3 on (0.0 mm): recorded in " \
+                                                              "the wrong slot?"
+    # The same position with the tool turned 5 deg is no pose of the grid: not "the wrong slot".
+    assert "wrong slot" not in diagnose(*args, np.array([0.0, 5.0]), *rest)[1]

@@ -76,3 +76,50 @@ def test_never_more_than_half_left_out(lab_real: Station) -> None:
         q = rt.typo(q, (t, 1, ON), 1, -12.0)
     fit = _fit_contacts(lab_real, q)
     assert int((~fit.used).sum()) <= (len(CONTACTS) - 1) // 2
+
+
+def _with_typos(station: Station, seed: int, n_bad: int, contact_only: bool, degrees: tuple[float, float]
+                ) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
+    rng = np.random.default_rng(seed)
+    q = rt.recorded_q(station, rng)
+    slots = [(t, h, k) for t in range(3) for h in range(3) for k in ((ON,) if contact_only else (ON, 1))]
+    injected = [slots[i] for i in rng.choice(len(slots), n_bad, replace=False)]
+    for s in injected:
+        q = rt.typo(q, s, int(rng.integers(6)), float(rng.choice([-1, 1]) * rng.uniform(*degrees)))
+    return q, injected
+
+
+@pytest.mark.parametrize("seed", [100, 101, 107, 108])
+def test_three_gross_errors_in_nine_contacts(lab_real: Station, seed: int) -> None:
+    # A third of the points wrong: the scale must come from every point (in the fit or not), else the trimmed
+    # start's closest points understate it and honest 3 mm points are left out too.
+    q, injected = _with_typos(lab_real, seed, 3, True, (3.0, 12.0))
+    fit = _fit_contacts(lab_real, q)
+    left_out = sorted(CONTACTS[i] for i in np.flatnonzero(~fit.used))
+    assert left_out == sorted(injected)
+    assert np.all(fit.severity[~fit.used] > 1.0) and np.all(fit.severity[fit.used] <= 1.0)
+
+
+@pytest.mark.parametrize(("seed", "n_bad", "contact_only"), [(200, 2, True), (200, 3, True), (200, 4, False),
+                                                            (201, 2, True), (201, 3, True), (202, 4, False)])
+def test_a_suspect_that_can_be_left_out_is_not_in_the_fit(lab_real: Station, seed: int, n_bad: int,
+                                                          contact_only: bool) -> None:
+    # Moderate errors (1.5-4 deg) sit near the thresholds: the fit that is kept must not contain a point it finds
+    # suspect and could do without (the prune step), so the station is the fit of the agreeing points only.
+    q, _ = _with_typos(lab_real, seed, n_bad, contact_only, (1.5, 4.0))
+    slots = CONTACTS if contact_only else [(t, h, k) for t in range(3) for h in range(3) for k in (ON, 1)]
+    m = measure(lab_real, [q[s] for s in slots])
+    model = choose_model(lab_real, slots)
+    assert model is not None
+    fit = robust_fit(lab_real, model, slots, m, np.ones(len(slots), dtype=bool))
+    assert not np.any(fit.used & fit.removable & (fit.severity > 1.0))
+
+
+@pytest.mark.parametrize(("seed", "delta_deg"), [(2, 2.5), (6, 2.5), (13, 2.0), (13, 2.5)])
+def test_a_tower_s_majority_wins_over_a_lone_wrong_point(lab_real: Station, seed: int, delta_deg: float) -> None:
+    # A moderate typo in the middle contact of a tower: a trimmed start may keep that tower's wrong point alone
+    # and leave out its two good neighbours (both fit a start exactly). Of the best starts, the one most points
+    # agree with is kept: the two good ones, not the lone wrong one.
+    q = rt.typo(rt.recorded_q(lab_real, np.random.default_rng(seed)), (1, 1, ON), 0, delta_deg)
+    fit = _fit_contacts(lab_real, q)
+    assert [CONTACTS[i] for i in np.flatnonzero(~fit.used)] == [(1, 1, ON)]

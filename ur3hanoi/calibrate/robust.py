@@ -14,7 +14,10 @@ every point looks equally wrong. Here:
    tower, the squared distance of its origin from the towers' median along the height step: the towers' first
    slots line up (stacked: all stand on one table; flat: the first rows form one line). This only breaks ties that
    positions alone leave open (in a contact-only table, swapping the first and last heights of a tower fits as
-   well as two wrong entries with the tower's origin moved by two steps); the final fit does not use it.
+   well as two wrong entries with the tower's origin moved by two steps); the final fit does not use it. The
+   :data:`N_STARTS` best distinct trimmed fits each go through step 3, and the one the most points agree with is
+   kept (ties: the better trimmed fit): a trimmed fit may keep one point of a tower only, and if that is the wrong
+   one, fewer of the others come back to it.
 2. **Scatter**: every point's deviation from the grid fitted to the *other* points of the fit is computed in
    closed form (:func:`ur3hanoi.calibrate.grid_fit.leave_one_out`), with its orientation error from the grid pose
    (tool pointing down at the circular-mean yaw of the points in the fit); a point outside the fit gets its
@@ -30,8 +33,8 @@ every point looks equally wrong. Here:
 3. **Grow and prune**, one point at a time: a point outside the fit whose deviation from it is within the
    thresholds is taken in; otherwise the point of the fit with the largest severity over 1 is left out, if the
    others still determine the grid. Never more than ``(N - 1) // 2`` points are left out. The thresholds stay
-   fixed while the fit grows and shrinks (first those of the trimmed start, then, once, those of the fit reached),
-   so the steps converge.
+   fixed while a fit grows and shrinks, so the steps converge: every start is grown under the thresholds of the
+   best trimmed fit, and the winner once more under those of its own fit.
 
 The deviation reported for a suspect is its distance from the grid fitted to all the others, so one gross error
 never drags the fit or hides behind the points it shares unknowns with.
@@ -71,6 +74,8 @@ MAXWELL_MEDIAN = 1.5382
 """Median length of a 3-D standard normal vector (chi distribution, 3 degrees of freedom)."""
 N_SUBSETS = 200
 """Random elemental subsets tried for the robust start (seeded: the same points always give the same fit)."""
+N_STARTS = 5
+"""Best distinct trimmed fits grown and pruned; the one most points agree with is kept."""
 _C_STEPS = 2  # concentration steps per subset; the best subset is iterated to convergence
 _SEED = 0
 
@@ -236,23 +241,27 @@ class _Lts:
             best = (objective, keep, sol)
         return best
 
-    def start(self, cand: np.ndarray) -> np.ndarray:
-        """The ``h`` candidates (indices) closest to the best trimmed fit."""
+    def starts(self, cand: np.ndarray) -> list[np.ndarray]:
+        """The :data:`N_STARTS` best distinct trimmed fits' ``h`` closest candidates (indices), best first."""
         n = len(cand)
         h = min(n, (n + math.ceil(self.model.n_unknowns / 3) + 1) // 2)
         rng = np.random.default_rng(_SEED)
-        best: tuple[float, np.ndarray, GridSolution] | None = None
+        found: dict[tuple[int, ...], tuple[float, GridSolution]] = {}
         for _ in range(N_SUBSETS):
             subset = self.elemental(cand[rng.permutation(n)])
             if subset is None:
                 continue
-            trial = self.concentrate(self.fit(subset), cand, h, _C_STEPS)
-            if best is None or trial[0] < best[0]:
-                best = trial
-        if best is None:
-            return cand
-        best = self.concentrate(best[2], cand, h, 50)
-        return best[1] if self.determined(best[1]) else cand
+            objective, keep, sol = self.concentrate(self.fit(subset), cand, h, _C_STEPS)
+            key = tuple(int(i) for i in keep)
+            if key not in found or objective < found[key][0]:
+                found[key] = (objective, sol)
+        best = sorted(found.items(), key=lambda item: item[1][0])[:N_STARTS]
+        out: list[np.ndarray] = []
+        for _, (_, sol) in best:
+            keep = self.concentrate(sol, cand, h, 50)[1]
+            if self.determined(keep) and not any(np.array_equal(keep, o) for o in out):
+                out.append(keep)
+        return out or [cand]
 
 
 def robust_fit(base: Station, model: GridModel, slots: Sequence[Slot], m: Measured, candidates: BoolArray,
@@ -263,30 +272,49 @@ def robust_fit(base: Station, model: GridModel, slots: Sequence[Slot], m: Measur
     ``candidates`` must determine ``model``. ``tol_mm`` / ``tol_deg`` replace the derived thresholds.
     """
     cand = np.flatnonzero(candidates)
-    max_left_out = (len(cand) - 1) // 2
-    used = np.zeros(len(slots), dtype=bool)
-    if 3 * len(cand) > model.n_unknowns:
-        used[_Lts(base, model, slots, m.p_world).start(cand)] = True
-    else:
-        used[cand] = True
-    fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg)
-    # Two stages with fixed thresholds (re-estimating them after every change could swing a point in and out):
-    # those of the trimmed start, then those of the fit it grew to.
-    for _stage in range(2):
-        frozen = fit.thresholds
-        for _ in range(4 * len(cand) + 4):
-            outside = np.where(candidates & ~used, fit.severity, np.inf)
-            inside = np.where(used & fit.removable, fit.severity, -np.inf)
-            take, drop = int(np.argmin(outside)), int(np.argmax(inside))
-            if outside[take] <= 1.0:
-                used[take] = True
-            elif inside[drop] > 1.0 and int((candidates & ~used).sum()) < max_left_out:
-                used[drop] = False
-            else:
-                break
-            fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen)
-        fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg)
-    return replace(fit, thresholds=frozen)
+    starts = _Lts(base, model, slots, m.p_world).starts(cand) if 3 * len(cand) > model.n_unknowns else [cand]
+
+    def mask(idx: np.ndarray) -> BoolArray:
+        used = np.zeros(len(slots), dtype=bool)
+        used[idx] = True
+        return used
+
+    # Every start is grown and pruned under the same thresholds (those of the best trimmed fit), so that "more
+    # points agree" compares like with like; the winner is then refined with the thresholds of its own fit.
+    # Thresholds stay fixed while a fit grows and shrinks: re-estimating them after every change could swing a
+    # point in and out.
+    frozen = _evaluate(base, model, slots, m, mask(starts[0]), candidates, tol_mm, tol_deg).thresholds
+    best: RobustFit | None = None
+    for start in starts:
+        fit = _grow_and_prune(base, model, slots, m, mask(start), candidates, tol_mm, tol_deg, frozen)
+        if best is None or int(fit.used.sum()) > int(best.used.sum()):
+            best = fit  # on a tie the earlier start: the better trimmed fit
+    assert best is not None
+    frozen = _evaluate(base, model, slots, m, best.used, candidates, tol_mm, tol_deg).thresholds
+    fit = _grow_and_prune(base, model, slots, m, best.used, candidates, tol_mm, tol_deg, frozen)
+    return replace(_evaluate(base, model, slots, m, fit.used, candidates, tol_mm, tol_deg), thresholds=frozen)
+
+
+def _grow_and_prune(base: Station, model: GridModel, slots: Sequence[Slot], m: Measured, used: BoolArray,
+                    candidates: BoolArray, tol_mm: float | None, tol_deg: float | None, frozen: Thresholds
+                    ) -> RobustFit:
+    """Step 3 of the module docstring, from the points ``used``, with the thresholds ``frozen``."""
+    n_cand = int(candidates.sum())
+    max_left_out = (n_cand - 1) // 2
+    used = used.copy()
+    fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen)
+    for _ in range(4 * n_cand + 4):
+        outside = np.where(candidates & ~used, fit.severity, np.inf)
+        inside = np.where(used & fit.removable, fit.severity, -np.inf)
+        take, drop = int(np.argmin(outside)), int(np.argmax(inside))
+        if outside[take] <= 1.0:
+            used[take] = True
+        elif inside[drop] > 1.0 and int((candidates & ~used).sum()) < max_left_out:
+            used[drop] = False
+        else:
+            break
+        fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen)
+    return fit
 
 
 __all__ = [
