@@ -1,4 +1,4 @@
-"""Robust grid fit: a high-breakdown start, then leave-one-out deletion with thresholds from the data's scatter.
+"""Robust grid fit: a high-breakdown start, then leave-one-out growing and pruning with thresholds from the data.
 
 Hand-recorded poses scatter by a few mm; some may be grossly wrong (a typo in one joint, an entry copied into the
 wrong slot, two slots swapped). A plain least-squares fit spreads such an error over the points that share its

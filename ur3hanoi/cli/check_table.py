@@ -19,7 +19,7 @@ def add(sub: argparse._SubParsersAction) -> None:
                                    "typo in one joint, swapped or copied entries). The reference is a calibration's "
                                    "intended poses (--calibration; default tolerance 1 mm / 0.5 deg, for generated "
                                    "tables) or the station grid fitted robustly to the table itself (--fit; "
-                                   "thresholds from the data's own scatter, max(3 mm, 5 sigma) / max(2 deg, 4 "
+                                   "thresholds from the data's own scatter, max(3 mm, 5 sigma) / max(2 deg, 5 "
                                    "sigma), for hand-recorded tables). Towers and heights are numbered from 1. Exit "
                                    "1 if any entry is suspect.")
     p.add_argument("file", help="lab-format YAML (generated or hand-recorded; null or left-out entries allowed)")
