@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import replace
@@ -13,7 +14,7 @@ import pinocchio as pin
 import pytest
 import yaml
 
-from ur3hanoi.calibrate import RESIDUAL_WARN_MM, CalibrationFit, fit_station
+from ur3hanoi.calibrate import MIN_SUSPECT_MM, CalibrationFit, fit_station
 from ur3hanoi.cli import main
 from ur3hanoi.errors import IKError, TaughtPointsError
 from ur3hanoi.grid import ABOVE, ON, T_world_tcp
@@ -24,6 +25,7 @@ from ur3hanoi.station import Station, load_station, station_to_dict
 from ur3hanoi.taught import TaughtPoint, TaughtPoints, taught_from_table
 from ur3hanoi.waypoints import generate_table
 
+from . import recorded_tables as rt
 from .conftest import LAB_REAL, LAB_SIM, REPO
 
 Slot = tuple[int, int, int]  # (tower, height, k)
@@ -100,7 +102,7 @@ def write_taught(path: Path, taught: TaughtPoints, units: str = "deg") -> Path:
     scale = 180.0 / math.pi if units == "deg" else 1.0
     pts = []
     for p in taught.points:
-        item: dict[str, object] = {"tower": p.tower, "height": p.height}
+        item: dict[str, object] = {"tower": p.tower + 1, "height": p.height + 1}  # numbered from 1 in files
         if p.k == ABOVE:
             item["pose"] = "above"
         item["q"] = [float(v * scale) for v in p.q]
@@ -177,7 +179,7 @@ def test_one_mm_noise_stays_within_1p5_mm(real_base: Station, slots: tuple[Slot,
     errs = contact_errors_m(truth, fit.station, ks=ks)
     assert np.max(errs) < 1.5e-3, f"worst regenerated pose off by {np.max(errs) * 1e3:.3f} mm"
     # 1 mm noise never looks like a mis-recorded point.
-    assert not any("residual" in w for w in fit.warnings)
+    assert fit.suspects == () and fit.warnings == () and fit.sound
 
 
 def test_outlier_is_named_in_the_residual_report(truth: Station, truth_base: Station) -> None:
@@ -192,12 +194,15 @@ def test_outlier_is_named_in_the_residual_report(truth: Station, truth_base: Sta
     assert fit.residuals_mm[outlier] > 7.0
     flagged = [r.index for r in fit.residual_table() if r.flagged]
     assert flagged == [outlier]
+    assert fit.used == tuple(i != outlier for i in range(len(slots)))
     assert len(fit.warnings) == 1
-    assert "points[8] (tower 1 height 1 on): residual" in fit.warnings[0]
-    assert np.sort(fit.residuals_mm)[-2] < RESIDUAL_WARN_MM
-    # Without the outlier's influence the grid is still close: the other slot of tower 1 height 1 agrees.
+    assert fit.warnings[0].startswith("tower 2 height 2 on [points[8]]: ")
+    assert "mm from the grid fitted to the other 17 contacts and 18 above poses" in fit.warnings[0]
+    assert np.sort(fit.residuals_mm)[-2] < MIN_SUSPECT_MM
+    # The outlier has no influence: the fit is the one without it, and the grid is close to the truth.
     clean = fit_station(base, TaughtPoints(tuple(p for p in taught.points if p.index != outlier), "<t>", ""))
-    assert np.max(contact_errors_m(truth, clean.station)) < 0.5e-3
+    np.testing.assert_allclose(fit.station.tower_origins, clean.station.tower_origins, atol=1e-12)
+    assert np.max(contact_errors_m(truth, fit.station)) < 0.5e-3
 
 
 def test_residual_table_rows_match_points(truth: Station, truth_base: Station) -> None:
@@ -224,7 +229,9 @@ def test_yaw_is_the_circular_mean_and_deviations_warn(truth: Station, truth_base
     assert math.degrees(float(np.angle(np.exp(1j * (fit.station.tool_yaw - truth.tool_yaw))))) == pytest.approx(
         0.0, abs=1e-2)
     assert fit.yaw_dev_deg[:2] == pytest.approx([3.0 - 0.0, -3.0], abs=0.05)
-    assert sum("tool heading" in w for w in fit.warnings) == 2
+    # Both are suspect, but the grid needs them (one point per tower): kept, and the fit is still sound.
+    assert [s.index for s in fit.suspects] in ([0, 1], [1, 0]) and fit.used == (True, True, True) and fit.sound
+    assert sum("heading +3.0 deg" in w or "heading -3.0 deg" in w for w in fit.warnings) == 2
 
 
 def test_flat_layout_default_step_turns_with_the_tower_row() -> None:
@@ -259,7 +266,7 @@ def test_from_table_round_trip_real_pos(real_base: Station) -> None:
 
 def test_underdetermined_points_are_refused(truth: Station, truth_base: Station) -> None:
     only_above = [(t, 0, ABOVE) for t in range(3)]
-    with pytest.raises(TaughtPointsError, match="do not determine the grid"):
+    with pytest.raises(TaughtPointsError, match=r"too little left to fit the grid: .*tower\(s\) 1, 2, 3 have none"):
         fit_station(truth_base, teach(truth, only_above))
 
 
@@ -276,7 +283,7 @@ def test_cli_calibrate_then_tables_end_to_end(truth: Station, truth_base: Statio
     rc, stdout, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(base_file), "-o", str(out)],
                               capsys)
     assert rc == 0, err
-    assert "wrote" in stdout and "0 warning(s)" in stdout
+    assert "wrote" in stdout and "0 suspect(s)" in stdout
     text = out.read_text()
     assert hashlib.sha256(taught_file.read_bytes()).hexdigest() in text.splitlines()[1]
     assert hashlib.sha256(base_file.read_bytes()).hexdigest() in text.splitlines()[2]
@@ -310,7 +317,7 @@ def test_cli_from_table_round_trip(tmp_path: Path, capsys: pytest.CaptureFixture
     rc, stdout, err = run_cli(["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos",
                                "--base", str(LAB_REAL), "-o", str(out)], capsys)
     assert rc == 0, err
-    assert "from 18 points" in stdout
+    assert "from 18 of 18 points" in stdout
     st = load_station(out)
     np.testing.assert_allclose(st.tower_origins, real_base.tower_origins, atol=1e-6)
     np.testing.assert_allclose(st.height_step, real_base.height_step, atol=1e-6)
@@ -326,8 +333,8 @@ def test_cli_prints_outlier_warning(truth: Station, truth_base: Station, tmp_pat
     rc, _, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(base_file),
                           "-o", str(tmp_path / "o.yaml")], capsys)
     assert rc == 0
-    assert "ur3hanoi: warning: points[3] (tower 0 height 1 above): residual" in err
-    assert err.count("residual") == 1
+    assert "ur3hanoi: warning: tower 1 height 2 above [points[3]]: 10.0 mm from the grid fitted to" in err
+    assert err.count("ur3hanoi: warning:") == 1
 
 
 def _tilted_q(truth: Station) -> list[float]:
@@ -337,29 +344,32 @@ def _tilted_q(truth: Station) -> list[float]:
 
 BAD_INPUTS = {
     # name: (taught-file text or None for a missing file, message fragment)
-    "missing-tower": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0}\n- {tower: 1, height: 0, q: Q1}\n",
-                      "tower 2 has no taught point (towers taught: [0, 1]"),
-    "joint-count": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0}\n"
-                    "- {tower: 1, height: 0, q: [1, 2, 3, 4, 5]}\n",
+    "missing-tower": ("units: deg\npoints:\n- {tower: 1, height: 1, q: Q0}\n- {tower: 2, height: 1, q: Q1}\n",
+                      "too little left to fit the grid: it needs a usable contact ('on') pose on every tower (3 "
+                      "towers), and above poses count only on towers that also have one; tower(s) 3 have none"),
+    "joint-count": ("units: deg\npoints:\n- {tower: 1, height: 1, q: Q0}\n"
+                    "- {tower: 2, height: 1, q: [1, 2, 3, 4, 5]}\n",
                     "field 'points[1].q' = [1, 2, 3, 4, 5] is invalid: expected a list of 6 numbers"),
-    "degrees-as-rad": ("units: rad\npoints:\n- {tower: 0, height: 0, q: Q0}\n", "looks like degrees"),
-    "radians-as-deg": ("units: deg\npoints:\n- {tower: 0, height: 0, q: [2.1, -1.5, 1.6, -1.6, -1.6, 0.5]}\n",
+    "degrees-as-rad": ("units: rad\npoints:\n- {tower: 1, height: 1, q: Q0}\n", "looks like degrees"),
+    "radians-as-deg": ("units: deg\npoints:\n- {tower: 1, height: 1, q: [2.1, -1.5, 1.6, -1.6, -1.6, 0.5]}\n",
                        "looks like radians"),
-    "tilted": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0}\n- {tower: 1, height: 0, q: QT}\n"
-               "- {tower: 2, height: 0, q: Q2}\n", "points[1] (tower 1 height 0 on): the tool is tilted 20.0 deg"),
-    "unknown-units": ("units: grad\npoints:\n- {tower: 0, height: 0, q: Q0}\n",
+    "tilted": ("units: deg\npoints:\n- {tower: 1, height: 1, q: Q0}\n- {tower: 2, height: 1, q: QT}\n"
+               "- {tower: 3, height: 1, q: Q2}\n",
+               "tower(s) 2 have none (left out: points[1] (tower 2 height 1 on): the tool is tilted 20.00 deg"),
+    "unknown-units": ("units: grad\npoints:\n- {tower: 1, height: 1, q: Q0}\n",
                       "field 'units' = 'grad' is invalid: expected one of deg, rad"),
-    "missing-units": ("points:\n- {tower: 0, height: 0, q: Q0}\n", "field 'units' is missing: expected one of deg"),
-    "tower-outside": ("units: deg\npoints:\n- {tower: 3, height: 0, q: Q0}\n",
-                      "tower 3 is outside the base calibration's grid (towers 0..2"),
-    "height-outside": ("units: deg\npoints:\n- {tower: 0, height: 3, q: Q0}\n",
-                       "height 3 is outside the base calibration's grid (heights 0..2"),
-    "bad-pose": ("units: deg\npoints:\n- {tower: 0, height: 0, pose: over, q: Q0}\n",
+    "missing-units": ("points:\n- {tower: 1, height: 1, q: Q0}\n", "field 'units' is missing: expected one of deg"),
+    "tower-outside": ("units: deg\npoints:\n- {tower: 4, height: 1, q: Q0}\n",
+                      "(left out: points[0] (tower 4 height 1 on): tower 4 is outside the base calibration's grid "
+                      "(towers 1..3"),
+    "height-outside": ("units: deg\npoints:\n- {tower: 1, height: 4, q: Q0}\n",
+                       "height 4 is outside the base calibration's grid (heights 1..3"),
+    "bad-pose": ("units: deg\npoints:\n- {tower: 1, height: 1, pose: over, q: Q0}\n",
                  "field 'points[0].pose' = 'over' is invalid: expected one of on, above"),
     "not-a-list": ("units: deg\npoints: 3\n", "field 'points' = 3 is invalid"),
-    "typo-height": ("units: deg\npoints:\n- {tower: 0, hieght: 0, q: Q0}\n",
+    "typo-height": ("units: deg\npoints:\n- {tower: 1, hieght: 1, q: Q0}\n",
                     "field 'points[0].hieght' is unknown: did you mean 'points[0].height'?"),
-    "duplicate-q": ("units: deg\npoints:\n- {tower: 0, height: 0, q: Q0, q: Q1}\n", "duplicate key 'q'"),
+    "duplicate-q": ("units: deg\npoints:\n- {tower: 1, height: 1, q: Q0, q: Q1}\n", "duplicate key 'q'"),
     "utf16": (None, "is UTF-16 text: save the taught-points file as UTF-8"),
     "malformed-yaml": ("units: deg\npoints: [\n", "not valid YAML"),
     "missing-file": (None, "cannot read the taught-points file (No such file or directory)"),
@@ -414,9 +424,87 @@ def test_cli_error_leaves_existing_output_untouched(tmp_path: Path, capsys: pyte
     out = tmp_path / "out.yaml"
     out.write_text("previous\n")
     taught_file = tmp_path / "t.yaml"
-    taught_file.write_text("units: rad\npoints:\n- {tower: 0, height: 0, q: [120, -90, 90, -90, -90, 0]}\n")
+    taught_file.write_text("units: rad\npoints:\n- {tower: 1, height: 1, q: [120, -90, 90, -90, -90, 0]}\n")
     rc, _, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(LAB_REAL), "-o", str(out)],
                          capsys)
     assert rc == 2 and "looks like degrees" in err
     assert out.read_text() == "previous\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.yaml", "t.yaml"]
+
+
+# ------------------------------------------------------------------------------------- gross errors, robustly
+
+GROSS = {
+    "typo10": lambda q: (rt.typo(q, (1, 2, ON), 1, 10.0), ["tower 2 height 3 on", "likely a typo in joint 2"]),
+    "duplicated": lambda q: (rt.duplicate(q, (0, 0, ON), (0, 1, ON)), ["tower 1 height 2 on", "a copied entry"]),
+    "swapped-heights": lambda q: (rt.swap(q, (2, 0, ON), (2, 2, ON)), ["tower 3 height 1 on", "swapped heights"]),
+    "swapped-towers": lambda q: (rt.swap(q, (0, 1, ON), (1, 1, ON)), ["height 2 on", "swapped towers"]),
+}
+
+
+@pytest.mark.parametrize("contact_only", [False, True], ids=["full", "contact-only"])
+@pytest.mark.parametrize("kind", sorted(GROSS))
+def test_cli_from_table_never_aborts_on_a_gross_error(kind: str, contact_only: bool, truth: Station,
+                                                      truth_base: Station, tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    base_file = write_base(tmp_path / "base.yaml", truth_base)
+    q, said = GROSS[kind](rt.recorded_q(truth, np.random.default_rng(len(kind))))
+    table = rt.write_table(tmp_path / "hand.yaml", "real_pos", rt.table_doc(q, contact_only=contact_only))
+    out = tmp_path / "station.yaml"
+    rc, stdout, err = run_cli(["calibrate", "--from-table", str(table), "--key", "real_pos", "--base", str(base_file),
+                               "-o", str(out)], capsys)
+    assert rc == 0, err
+    first = err.splitlines()[0]
+    assert first.startswith("ur3hanoi: warning: ") and all(s in first for s in said), err
+    assert "suspects, worst first:" in stdout and "# left out (suspect): real_pos[" in out.read_text()
+    # The station of the remaining entries is within the noise of the truth.
+    assert np.max(contact_errors_m(truth, load_station(out))) < rt.NOISE_MM[1] * 1e-3
+
+
+def test_cli_taught_points_with_swapped_labels(truth: Station, truth_base: Station, tmp_path: Path,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    taught = teach(truth, FULL, np.random.default_rng(30), noise_m=0.001)
+    pts = list(taught.points)
+    # Heights 1 and 3 of tower 2's contact written the wrong way round.
+    pts[6], pts[10] = replace(pts[6], q=pts[10].q), replace(pts[10], q=pts[6].q)
+    taught_file = write_taught(tmp_path / "taught.yaml", TaughtPoints(tuple(pts), "<t>", ""))
+    base_file = write_base(tmp_path / "base.yaml", truth_base)
+    rc, _, err = run_cli(["calibrate", "--taught", str(taught_file), "--base", str(base_file), "-o",
+                          str(tmp_path / "o.yaml")], capsys)
+    assert rc == 0, err
+    warnings = err.splitlines()[:2]
+    assert sorted(w.split(" [")[0] for w in warnings) == ["ur3hanoi: warning: tower 2 height 1 on",
+                                                           "ur3hanoi: warning: tower 2 height 3 on"]
+    assert all("swapped heights with points[" in w for w in warnings)
+
+
+def test_a_tilted_point_is_left_out_not_a_reason_to_stop(truth: Station, truth_base: Station) -> None:
+    taught = teach(truth, FULL)
+    pts = list(taught.points)
+    pts[4] = replace(pts[4], q=tuple(math.radians(v) for v in _tilted_q(truth)))
+    fit = fit_station(truth_base, pts)
+    assert fit.sound and [s.index for s in fit.suspects] == [4] and not fit.used[4]
+    assert fit.suspects[0].reason.endswith("the tool is tilted 20.00 deg from pointing down (more than 10 deg: left "
+                                           "out of the fit)")
+
+
+def test_cli_unsound_fit_writes_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # The stacked real_pos table with the flat simulator's base: the fitted step is not a flat layout's.
+    out = tmp_path / "o.yaml"
+    rc, stdout, err = run_cli(["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos", "--base", "lab_sim",
+                               "-o", str(out)], capsys)
+    assert rc == 2 and not out.exists()
+    assert err.count("\n") == 1 and "the fit is not sound, nothing written: the fitted grid is invalid" in err
+    assert "reference: grid fitted" in stdout
+
+
+def test_cli_calibrate_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "o.yaml"
+    rc, stdout, err = run_cli(["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos", "--base",
+                               str(LAB_REAL), "-o", str(out), "--json"], capsys)
+    assert rc == 0 and out.exists()
+    doc = json.loads(stdout)
+    assert set(doc) == {"entries", "suspects", "fit"} and doc["suspects"] == []
+    assert len(doc["entries"]) == 18 and doc["entries"][0]["field"] == "real_pos[0][0][0]"
+    assert doc["fit"]["points_used"] == 18 and doc["fit"]["rms_mm"] < 1e-6
+    assert err.startswith(f"wrote {out}: fitted ")

@@ -52,7 +52,7 @@ def test_unreachable_grid_exits_2_with_one_line_and_writes_nothing(tmp_path: Pat
     out = tmp_path / "lab2_data.yaml"
     assert main(["tables", str(cal), "--key", "real_pos", "-o", str(out)]) == 2
     err = _one_error_line(capsys.readouterr().err)
-    assert "tower 2 height 0 on" in err and "unreachable" in err and "target xyz" in err and "residual" in err
+    assert "tower 3 height 1 on" in err and "unreachable" in err and "target xyz" in err and "residual" in err
     assert not out.exists()
 
 

@@ -86,3 +86,13 @@ def test_number_accepts_only_finite_numbers_in_range(value: Any) -> None:
     ok = (not isinstance(value, bool) and isinstance(value, int | float) and math.isfinite(value)
           and 0.0 < value <= 0.2)
     assert spec.accepts(value) == ok
+
+
+def test_nullable_accepts_null_or_a_valid_value() -> None:
+    from ur3hanoi.io.schema import Nullable
+
+    spec = ListOf(Nullable(Vector(2, Number(0, 1))), 1, 3, what="pairs")
+    validate([None, [0.5, 1], None], spec, "f.yaml")
+    with pytest.raises(InputError, match=r"field 'x\[1\]\[0\]' = 2 is invalid: expected a number in \[0, 1\]"):
+        validate([None, [2, 0]], spec, "f.yaml", path="x")
+    assert Nullable(Number(0, 1)).expected() == "a number in [0, 1], or null"

@@ -16,7 +16,7 @@ from ur3hanoi.cli import main
 from ur3hanoi.errors import OutputError, TableError
 from ur3hanoi.grid import T_world_tcp
 from ur3hanoi.ik import pose_errors
-from ur3hanoi.labfile import parse_q, read_lab_file, read_table, write_table
+from ur3hanoi.labfile import parse_q, read_lab_file, read_recorded_table, read_table, write_table
 from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import Station
 from ur3hanoi.waypoints import generate_table
@@ -144,7 +144,8 @@ def test_unparseable_existing_file_is_not_touched(lab_sim: Station, tmp_path: Pa
     ("value", "match"),
     [
         ("nope", r"field 'real_pos' = 'nope' is invalid: expected a list of 1..10 towers"),
-        ([[[[0.0] * 6]]], r"field 'real_pos\[0\]\[0\]' .* expected a list of exactly 2 poses \[on, above\]"),
+        ([[[[0.0] * 6] * 3]], r"field 'real_pos\[0\]\[0\]' .* expected a list of 1..2 poses \[on, above\]"),
+        ([[[[0.0] * 6]]], r"1 of 2 entries are missing \(tower 1 height 1 above\): this needs a complete table"),
         ([[[[0.0] * 5, [0.0] * 6]]], r"field 'real_pos\[0\]\[0\]\[0\]' .* expected a list of 6 numbers"),
         ([[[[0.0] * 5 + [float("nan")], [0.0] * 6]]], r"field 'real_pos\[0\]\[0\]\[0\]\[5\]' = nan"),
         ([[[[0.0] * 5 + [10**400], [0.0] * 6]]], r"real_pos\[0\]\[0\]\[0\]\[5\]' = 1000.*0 is invalid"),
@@ -152,12 +153,12 @@ def test_unparseable_existing_file_is_not_touched(lab_sim: Station, tmp_path: Pa
          r"= 120.0 is invalid: expected a joint angle \[rad\] in \[-6.28319, 6.28319\]"),
         ([[[[0.0] * 6, [0.0] * 6]], [[[0.0] * 6, [0.0] * 6]] * 2], r"field 'real_pos\[1\]' .* 1 heights like"),
     ],
-    ids=["not-a-list", "one-pose", "five-joints", "nan", "huge-int", "degrees", "ragged"],
+    ids=["not-a-list", "three-poses", "on-only", "five-joints", "nan", "huge-int", "degrees", "ragged"],
 )
 def test_parse_q_errors_name_the_entry(value: object, match: str) -> None:
     with pytest.raises(TableError, match=match) as info:
         parse_q(value, "f.yaml", "real_pos")
-    assert str(info.value).startswith("f.yaml: field 'real_pos")
+    assert str(info.value).startswith("f.yaml")
     assert len(str(info.value)) < 300
 
 
@@ -295,3 +296,63 @@ def test_concurrent_tables_runs_never_lose_a_key(lab_sim: Station, lab_real: Sta
 
 def _listing(directory: Path) -> list[str]:
     return sorted(p.name for p in directory.iterdir())
+
+
+# ------------------------------------------------------------------------------------------- recorded tables
+
+ON_Q = [2.1, -1.2, 1.8, -2.2, -1.57, 0.5]
+ABOVE_Q = [2.1, -1.4, 1.6, -1.8, -1.57, 0.5]
+
+
+def test_generated_comments_number_towers_and_heights_from_1(lab_sim: Station, tmp_path: Path) -> None:
+    out = tmp_path / "t.yaml"
+    text = write_table(out, generate_table(lab_sim), "sim_pos")
+    assert "]  # tower 1 height 1 on\n" in text and "]  # tower 3 height 3 above\n" in text
+    assert "# tower 3 height 3 [m, world]" in text
+    assert "tower 0" not in text and "height 0" not in text
+
+
+def test_recorded_table_marks_missing_entries_in_every_form(tmp_path: Path) -> None:
+    # tower 1: [on] only (above left out) and a null above; tower 2: a null slot; tower 3: null.
+    doc = {"real_pos": [[[ON_Q], [ON_Q, None], [ON_Q, ABOVE_Q]], [[ON_Q, ABOVE_Q], None, [ON_Q, ABOVE_Q]], None]}
+    path = tmp_path / "t.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    rec = read_recorded_table(path, "real_pos")
+    assert rec.q.shape == (3, 3, 2, 6)
+    assert rec.missing == ((0, 0, 1), (0, 1, 1), (1, 1, 0), (1, 1, 1), (2, 0, 0), (2, 0, 1), (2, 1, 0), (2, 1, 1),
+                           (2, 2, 0), (2, 2, 1))
+    assert rec.present.sum() == 8 and np.isnan(rec.q[~rec.present]).all()
+    np.testing.assert_array_equal(rec.q[0, 2, 1], ABOVE_Q)
+    with pytest.raises(TableError, match=r"t.yaml:real_pos: 10 of 18 entries are missing \(tower 1 height 1 above, "
+                                         r"tower 1 height 2 above, tower 2 height 2 on, .* and 4 more\): this needs a "
+                                         r"complete table"):
+        read_table(path, "real_pos")
+
+
+def test_shared_above_is_detected_by_alias_and_by_copy(tmp_path: Path) -> None:
+    other = [v + 0.1 for v in ABOVE_Q]
+    aliased = (f"real_pos:\n- - [{ON_Q}, &above_a {ABOVE_Q}]\n  - [{ON_Q}, *above_a]\n  - [{ON_Q}, *above_a]\n"
+               f"- - [{ON_Q}, {ABOVE_Q}]\n  - [{ON_Q}, {ABOVE_Q}]\n  - [{ON_Q}, {other}]\n")
+    path = tmp_path / "t.yaml"
+    path.write_text(aliased)
+    rec = read_recorded_table(path, "real_pos")
+    # tower 1 shares one above pose through a YAML alias, tower 2 copies it into heights 1 and 2 only.
+    assert rec.shared_above == ((0, (0, 1, 2)), (1, (0, 1)))
+    assert rec.shared_with(0, 2) == (0, 1, 2) and rec.shared_with(1, 2) == ()
+    assert rec.missing == ()
+
+
+def test_all_null_key_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "t.yaml"
+    path.write_text("real_pos: [null, null]\n")
+    with pytest.raises(TableError, match="field 'real_pos' holds no entry"):
+        read_recorded_table(path, "real_pos")
+
+
+def test_writing_a_key_keeps_a_partial_hand_recorded_key(lab_sim: Station, tmp_path: Path) -> None:
+    hand = f"real_pos:\n- - [{ON_Q}]\n  - null\n- - [{ON_Q}, {ABOVE_Q}]\n  - [{ON_Q}, null]\n"
+    out = tmp_path / "lab2_data.yaml"
+    out.write_text(hand)
+    write_table(out, generate_table(lab_sim), "sim_pos")
+    assert hand in out.read_text()
+    assert read_recorded_table(out, "real_pos").missing == ((0, 0, 1), (0, 1, 0), (0, 1, 1), (1, 1, 1))

@@ -115,6 +115,12 @@ def test_stacked_height_step_must_be_one_block() -> None:
         parse_station(_mutated(LAB_REAL, "grid.height_step", [0.0, 0.0, 0.05]), "bad.yaml")
 
 
+def test_overlapping_towers_are_numbered_from_1() -> None:
+    origins = [[0.25, -0.20, 0.0288], [0.25, -0.09, 0.0288], [0.25, -0.08, 0.0288]]
+    with pytest.raises(CalibrationError, match=r"expected towers 2 and 3 at least blocks.size = 0.0318 m apart"):
+        parse_station(_mutated(LAB_REAL, "grid.tower_origins", origins), "bad.yaml")
+
+
 def test_tower_origins_count_must_match() -> None:
     with pytest.raises(CalibrationError, match=r"grid\.tower_origins"):
         parse_station(_mutated(LAB_REAL, "grid.towers", 4), "bad.yaml")

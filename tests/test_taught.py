@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 import pytest
+import yaml
 
 from ur3hanoi.errors import TableError, TaughtPointsError
 from ur3hanoi.grid import ABOVE, ON
@@ -20,10 +21,12 @@ HOME_DEG = [120, -90, 90, -90, -90, 0]
 
 def test_load_taught_converts_degrees(tmp_path: Path) -> None:
     f = tmp_path / "t.yaml"
-    f.write_text("units: deg\npoints:\n- {tower: 0, height: 1, pose: above, q: [120, -90, 90, -90, -90, 0]}\n")
+    f.write_text("units: deg\npoints:\n- {tower: 1, height: 2, pose: above, q: [120, -90, 90, -90, -90, 0]}\n")
     taught = load_taught(f)
     (p,) = taught.points
+    # Numbered from 1 in the file, 0-based indices in code.
     assert (p.tower, p.height, p.k) == (0, 1, ABOVE)
+    assert p.label == "points[0] (tower 1 height 2 above)"
     assert p.q == pytest.approx([math.radians(v) for v in HOME_DEG], abs=1e-15)
     assert taught.sha256 == hashlib.sha256(f.read_bytes()).hexdigest()
 
@@ -38,21 +41,24 @@ def test_shipped_example_loads() -> None:
     ("data", "message"),
     [
         ({"units": "deg", "point": []}, "field 'point' is unknown: did you mean 'points'?"),
-        ({"units": "deg", "points": [{"tower": 0, "height": 0, "q": HOME_DEG, "pose": "on", "tilt": 0}]},
+        ({"units": "deg", "points": [{"tower": 1, "height": 1, "q": HOME_DEG, "pose": "on", "tilt": 0}]},
          "field 'points[0].tilt' is unknown: expected one of points[0].tower, points[0].height, points[0].pose, "
          "points[0].q"),
-        ({"units": "deg", "points": [{"tower": 0, "height": 0}]},
+        ({"units": "deg", "points": [{"tower": 1, "height": 1}]},
          "field 'points[0].q' is missing: expected a list of 6 numbers, each a joint value (in 'units') in "
          "[-360, 360]"),
-        ({"units": "deg", "points": [{"tower": -1, "height": 0, "q": HOME_DEG}]},
-         "field 'points[0].tower' = -1 is invalid: expected a 0-based tower index in [0, 9]"),
-        ({"units": "deg", "points": [{"tower": 0, "height": 0, "q": [*HOME_DEG[:5], float("nan")]}]},
+        ({"units": "deg", "points": [{"tower": 0, "height": 1, "q": HOME_DEG}]},
+         "field 'points[0].tower' = 0 is invalid: expected a tower number (numbering starts at 1) in [1, 10]"),
+        ({"units": "deg", "points": [{"tower": 1, "height": 0, "q": HOME_DEG}]},
+         "field 'points[0].height' = 0 is invalid: expected a height (numbering starts at 1: 1 = bottom) in [1, 20]"),
+        ({"units": "deg", "points": [{"tower": 1, "height": 1, "q": [*HOME_DEG[:5], float("nan")]}]},
          "field 'points[0].q[5]' = nan is invalid"),
         ({"units": "deg", "points": []}, "field 'points' = [] is invalid: expected a list of 1..1000 points"),
-        ({"units": "rad", "points": [{"tower": 0, "height": 0, "q": HOME_DEG}]},
-         "points[0] (tower 0 height 0 on): joint value 120 is outside +-2pi with units rad: looks like degrees"),
+        ({"units": "rad", "points": [{"tower": 1, "height": 1, "q": HOME_DEG}]},
+         "points[0] (tower 1 height 1 on): joint value 120 is outside +-2pi with units rad: looks like degrees"),
     ],
-    ids=["typo-points", "unknown-point-key", "missing-q", "negative-tower", "nan", "empty", "degrees-as-rad"],
+    ids=["typo-points", "unknown-point-key", "missing-q", "zero-tower", "zero-height", "nan", "empty",
+         "degrees-as-rad"],
 )
 def test_invalid_taught_points_name_file_and_field(data: object, message: str) -> None:
     with pytest.raises(TaughtPointsError) as info:
@@ -64,6 +70,20 @@ def test_taught_from_table_uses_every_entry() -> None:
     taught = taught_from_table(REPO / "tables/lab2_data.yaml", "real_pos")
     assert len(taught.points) == 18
     assert [(p.tower, p.height, p.k) for p in taught.points[:3]] == [(0, 0, ON), (0, 0, ABOVE), (0, 1, ON)]
+    assert taught.points[2].label == "real_pos[0][1][0] (tower 1 height 2 on)"
+    assert taught.shape == (3, 3) and taught.missing == ()
+
+
+def test_taught_from_table_keeps_what_is_present(tmp_path: Path) -> None:
+    on, above = [2.1, -1.2, 1.8, -2.2, -1.57, 0.5], [2.1, -1.4, 1.6, -1.8, -1.57, 0.5]
+    path = tmp_path / "t.yaml"
+    path.write_text(yaml.safe_dump({"real_pos": [[[on, above], [on, above]], [[on], [on, None]]]}))
+    taught = taught_from_table(path, "real_pos")
+    assert [p.where for p in taught.points] == ["real_pos[0][0][0]", "real_pos[0][0][1]", "real_pos[0][1][0]",
+                                                "real_pos[0][1][1]", "real_pos[1][0][0]", "real_pos[1][1][0]"]
+    assert taught.missing == ((1, 0, ABOVE), (1, 1, ABOVE))
+    # Tower 1's two above poses are the same values: one pose shared by both heights.
+    assert [p.shared for p in taught.points] == [(), (0, 1), (), (0, 1), (), ()]
 
 
 def test_taught_from_table_refuses_a_degree_table(tmp_path: Path) -> None:

@@ -55,3 +55,16 @@ def test_check_table_tolerance_is_applied(lab_real: Station) -> None:
 def test_check_table_shape_mismatch(lab_real: Station) -> None:
     with pytest.raises(TableError, match="2 towers x 3 heights"):
         check_table(np.zeros((2, 3, 2, 6)), lab_real)
+
+
+def test_pose_label_numbers_from_1() -> None:
+    assert pose_label(0, 0, 0) == "tower 1 height 1 on"
+    assert pose_label(2, 1, 1) == "tower 3 height 2 above"
+
+
+def test_check_table_skips_missing_entries(lab_real: Station) -> None:
+    q = generate_table(lab_real).q.copy()
+    q[1, 2, 1] = np.nan
+    rows = check_table(q, lab_real)
+    assert len(rows) == 17 and all(r.ok for r in rows)
+    assert (1, 2, 1) not in {(r.tower, r.height, r.k) for r in rows}

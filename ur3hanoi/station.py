@@ -298,7 +298,7 @@ def validate(s: Station) -> None:
             b = s.tower_origins[j]
             if np.linalg.norm(np.subtract(a, b)[:2]) < s.block_size:
                 raise fail(src, "grid.tower_origins", [list(a), list(b)],
-                           f"towers {i} and {j} at least blocks.size = {s.block_size} m apart in xy")
+                           f"towers {i + 1} and {j + 1} at least blocks.size = {s.block_size} m apart in xy")
 
 
 def station_to_dict(s: Station) -> dict[str, Any]:

@@ -1,20 +1,24 @@
 """Taught points: joint poses recorded on the teach pendant, read from a file or taken from a lab table.
 
-Taught-points file (tower and height are 0-based, like ``Q[tower][height]`` of ``lab2_data.yaml``)::
+Taught-points file. Towers and heights are numbered from 1, as people count them (``tower: 1, height: 1`` is the
+bottom block of the first tower, ``Q[0][0]`` of ``lab2_data.yaml``); a 0 is an error that says so::
 
     units: deg            # deg | rad (required: a pose in the wrong unit is caught, see below)
     points:               # contact ("on") poses unless `pose: above`
-      - {tower: 0, height: 0, q: [..6 joint values..]}
-      - {tower: 1, height: 0, q: [...]}
-      - {tower: 2, height: 0, q: [...]}
-      - {tower: 0, height: 2, q: [...]}                # optional extra points
-      - {tower: 1, height: 0, pose: above, q: [...]}
+      - {tower: 1, height: 1, q: [..6 joint values..]}
+      - {tower: 2, height: 1, q: [...]}
+      - {tower: 3, height: 1, q: [...]}
+      - {tower: 1, height: 3, q: [...]}                # optional extra points
+      - {tower: 2, height: 1, pose: above, q: [...]}
 
 The file is read by the strict loader (:mod:`ur3hanoi.io.yaml_loader`) and checked against :data:`TAUGHT_SCHEMA`:
 an unknown key (``point:``, ``towre:``) is an error naming the nearest valid one, and so is a duplicate key, a
 wrong joint count, a non-finite value, or a value outside +-360. Degrees written under ``units: rad`` (or radians
-under ``units: deg``) are caught by their size. Alternatively every entry ``Q[t][h][k]`` of a lab table is a taught
-point (:func:`taught_from_table`).
+under ``units: deg``) are caught by their size. Alternatively every entry ``Q[t][h][k]`` present in a lab table is
+a taught point (:func:`taught_from_table`); the missing entries and the "above" poses shared by the heights of a
+tower are recorded with them (see :mod:`ur3hanoi.labfile`).
+
+In code, :class:`TaughtPoint` holds 0-based indices (``tower = 0`` is the first tower), like ``Q[tower][height]``.
 """
 
 from __future__ import annotations
@@ -30,9 +34,10 @@ from ur3hanoi.grid import ABOVE, ON, POSE_NAMES
 from ur3hanoi.io.schema import Choice, Field, ListOf, Number, Record, Vector
 from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
-from ur3hanoi.labfile import read_lab_file, table_of
+from ur3hanoi.labfile import RecordedTable, Slot, read_recorded_table
 from ur3hanoi.robot import N_JOINTS
 from ur3hanoi.station import MAX_HEIGHTS, MAX_TOWERS
+from ur3hanoi.waypoints import pose_label
 
 UNITS: tuple[str, ...] = ("deg", "rad")
 MAX_TAUGHT_POINTS = 1000
@@ -41,8 +46,8 @@ _TWO_PI = 2 * math.pi
 TAUGHT_SCHEMA = Record({
     "units": Field(Choice(UNITS)),
     "points": Field(ListOf(Record({
-        "tower": Field(Number(0, MAX_TOWERS - 1, integer=True, what="a 0-based tower index")),
-        "height": Field(Number(0, MAX_HEIGHTS - 1, integer=True, what="a 0-based height index")),
+        "tower": Field(Number(1, MAX_TOWERS, integer=True, what="a tower number (numbering starts at 1)")),
+        "height": Field(Number(1, MAX_HEIGHTS, integer=True, what="a height (numbering starts at 1: 1 = bottom)")),
         "pose": Field(Choice(POSE_NAMES), required=False),
         "q": Field(Vector(N_JOINTS, Number(-360.0, 360.0, what="a joint value (in 'units')"))),
     }), 1, MAX_TAUGHT_POINTS, what="points {tower, height, q[, pose]}")),
@@ -56,9 +61,12 @@ class TaughtPoint:
 
     Attributes:
         index: position in the taught list (``points[index]``; table entries are numbered in Q order).
-        tower, height: grid slot, 0-based.
+        tower, height: grid slot, 0-based indices (people read ``tower + 1``, ``height + 1``).
         k: 0 = contact ("on") pose, 1 = the pose above it.
         q: joint angles [rad], controller convention.
+        field: where the point is in its file (``points[3]``, ``real_pos[1][2][0]``); default ``points[index]``.
+        shared: for an "above" pose of a table shared by several heights of its tower, those heights (0-based,
+            this one included); else ``()``.
     """
 
     index: int
@@ -66,19 +74,37 @@ class TaughtPoint:
     height: int
     k: int
     q: tuple[float, ...]
+    field: str = ""
+    shared: tuple[int, ...] = ()
+
+    @property
+    def where(self) -> str:
+        """The point's field path in its file."""
+        return self.field or f"points[{self.index}]"
 
     @property
     def label(self) -> str:
-        return f"points[{self.index}] (tower {self.tower} height {self.height} {POSE_NAMES[self.k]})"
+        """``points[3] (tower 1 height 2 above)``: the field path, and the slot numbered from 1."""
+        return f"{self.where} ({pose_label(self.tower, self.height, self.k)})"
 
 
 @dataclass(frozen=True)
 class TaughtPoints:
-    """The taught poses of one file, with provenance for the output's header."""
+    """The taught poses of one file, with provenance for the output's header.
+
+    Attributes:
+        points: the poses, in file order.
+        source: the file (``"<file>:<key>"`` for a table).
+        sha256: hex digest of the file's bytes.
+        missing: for a table, its missing entries ``(tower, height, k)`` (0-based); else ``()``.
+        shape: for a table, its ``(towers, heights)``; else None.
+    """
 
     points: tuple[TaughtPoint, ...]
     source: str
     sha256: str
+    missing: tuple[Slot, ...] = ()
+    shape: tuple[int, int] | None = None
 
 
 def _fail(source: str, msg: str) -> TaughtPointsError:
@@ -113,7 +139,7 @@ def parse_taught(data: Any, source: str = "<memory>", sha256: str = "") -> Taugh
     """
     validate_schema(data, TAUGHT_SCHEMA, source, TaughtPointsError)
     units = data["units"]
-    raw = [TaughtPoint(index=i, tower=int(item["tower"]), height=int(item["height"]),
+    raw = [TaughtPoint(index=i, tower=int(item["tower"]) - 1, height=int(item["height"]) - 1,
                        k=POSE_NAMES.index(item.get("pose", "on")), q=tuple(float(v) for v in item["q"]))
            for i, item in enumerate(data["points"])]  # q still in `units`
     _check_units(source, [p.q for p in raw], units, [p.label for p in raw])
@@ -133,20 +159,26 @@ def load_taught(path: str | Path) -> TaughtPoints:
 
 
 def taught_from_table(path: str | Path, key: str) -> TaughtPoints:
-    """Every entry ``Q[t][h][k]`` [rad] of a lab-format table as a taught point (numbered in Q order).
+    """Every entry ``Q[t][h][k]`` [rad] present in a lab-format table as a taught point (numbered in Q order).
 
     Raises:
-        TableError: the table file is invalid or has no ``key``.
+        TableError: the table file is invalid, has no ``key``, or the key holds no entry.
         TaughtPointsError: the entries look like degrees.
     """
-    lab = read_lab_file(path)
-    q = table_of(lab, path, key)
-    source = f"{path}:{key}"
-    slots = [(t, h, k) for t in range(q.shape[0]) for h in range(q.shape[1]) for k in (ON, ABOVE)]
-    points = tuple(TaughtPoint(index=i, tower=t, height=h, k=k, q=tuple(float(v) for v in q[t, h, k]))
-                   for i, (t, h, k) in enumerate(slots))
-    _check_units(source, [p.q for p in points], "rad", [f"{source}[{t}][{h}][{k}]" for t, h, k in slots])
-    return TaughtPoints(points=points, source=source, sha256=lab.sha256)
+    return taught_from_recorded(read_recorded_table(path, key))
+
+
+def taught_from_recorded(table: RecordedTable) -> TaughtPoints:
+    """The entries present in ``table`` as taught points (see :func:`taught_from_table`)."""
+    slots = [(t, h, k) for t in range(table.n_towers) for h in range(table.n_heights) for k in (ON, ABOVE)
+             if table.present[t, h, k]]
+    points = tuple(
+        TaughtPoint(index=i, tower=t, height=h, k=k, q=tuple(float(v) for v in table.q[t, h, k]),
+                    field=f"{table.key}[{t}][{h}][{k}]", shared=table.shared_with(t, h) if k == ABOVE else ())
+        for i, (t, h, k) in enumerate(slots))
+    _check_units(table.source, [p.q for p in points], "rad", [p.label for p in points])
+    return TaughtPoints(points=points, source=table.source, sha256=table.sha256, missing=table.missing,
+                        shape=(table.n_towers, table.n_heights))
 
 
 __all__ = [
@@ -157,5 +189,6 @@ __all__ = [
     "TaughtPoints",
     "load_taught",
     "parse_taught",
+    "taught_from_recorded",
     "taught_from_table",
 ]

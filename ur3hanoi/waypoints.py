@@ -42,8 +42,9 @@ class Table:
 
 
 def pose_label(tower: int, height: int, k: int) -> str:
-    """``"tower 1 height 2 above"`` (0-based indices, as in the file)."""
-    return f"tower {tower} height {height} {POSE_NAMES[k]}"
+    """How people name ``Q[tower][height][k]`` (0-based indices): ``pose_label(0, 1, 1) == "tower 1 height 2
+    above"``. Towers and heights are numbered from 1 wherever a person reads them."""
+    return f"tower {tower + 1} height {height + 1} {POSE_NAMES[k]}"
 
 
 def generate_table(station: Station, solver: str | IKSolver = "pinocchio") -> Table:
@@ -69,7 +70,8 @@ def generate_table(station: Station, solver: str | IKSolver = "pinocchio") -> Ta
 
 @dataclass(frozen=True)
 class CheckRow:
-    """FK error of one table entry against the calibration's intended pose."""
+    """FK error of one table entry against the calibration's intended pose; ``tower``, ``height``, ``k`` are
+    0-based indices into ``Q``."""
 
     tower: int
     height: int
@@ -82,6 +84,8 @@ class CheckRow:
 def check_table(q: FloatArray, station: Station, tol_mm: float = 1.0, tol_deg: float = 0.5,
                 where: str = "table") -> list[CheckRow]:
     """FK of every entry of ``q`` (T, H, 2, 6) [rad] vs ``station``'s intended TCP poses, in mm and deg.
+
+    Entries that are NaN (missing, see :class:`ur3hanoi.labfile.RecordedTable`) get no row.
 
     Raises:
         TableError: the table's towers x heights differ from the station's grid.
@@ -98,6 +102,8 @@ def check_table(q: FloatArray, station: Station, tol_mm: float = 1.0, tol_deg: f
     for t in range(q.shape[0]):
         for h in range(q.shape[1]):
             for k in (0, 1):
+                if np.isnan(q[t, h, k]).any():
+                    continue
                 dp, dr = pose_errors(T_wb * robot.fk(q[t, h, k]), T_world_tcp(station, t, h, k))
                 mm, deg = dp * 1e3, math.degrees(dr)
                 rows.append(CheckRow(t, h, k, mm, deg, mm <= tol_mm and deg <= tol_deg))

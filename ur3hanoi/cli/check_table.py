@@ -1,45 +1,60 @@
-"""``ur3hanoi check-table``: FK of every entry of a lab table against a calibration's intended poses."""
+"""``ur3hanoi check-table``: audit every entry of a lab table against a calibration, or against the grid fitted to
+the table itself (``--fit``); see :mod:`ur3hanoi.audit`."""
 
 from __future__ import annotations
 
 import argparse
+import json
 
 from ur3hanoi.cli import exit_codes
-from ur3hanoi.cli.options import TOL_DEG, TOL_MM, option
+from ur3hanoi.cli.options import TOL_DEG, TOL_MM, UsageError, option
 from ur3hanoi.labfile import TABLE_KEYS
 
 
 def add(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("check-table", help="FK-check every entry of a lab-format table against a calibration",
-                       description="Report, for every Q[tower][height][k] of FILE, the FK position [mm] and "
-                                   "orientation [deg] error of the suction point against the calibration's "
-                                   "intended pose; exit 1 if any entry exceeds the tolerance.")
-    p.add_argument("file", help="lab-format YAML (generated or hand-recorded)")
+    p = sub.add_parser("check-table", help="audit a lab-format table: against a calibration, or its own fitted grid",
+                       description="Report, for every Q[tower][height][k] of FILE, the FK position [mm], orientation "
+                                   "and tilt [deg] error of the suction point against a reference, the missing "
+                                   "entries, and the suspect entries worst first with what probably happened (a "
+                                   "typo in one joint, swapped or copied entries). The reference is a calibration's "
+                                   "intended poses (--calibration; default tolerance 1 mm / 0.5 deg, for generated "
+                                   "tables) or the station grid fitted robustly to the table itself (--fit; "
+                                   "thresholds from the data's own scatter, max(3 mm, 5 sigma) / max(2 deg, 5 "
+                                   "sigma), for hand-recorded tables). Towers and heights are numbered from 1. Exit "
+                                   "1 if any entry is suspect.")
+    p.add_argument("file", help="lab-format YAML (generated or hand-recorded; null or left-out entries allowed)")
     p.add_argument("--key", required=True, choices=TABLE_KEYS, help="table key")
-    p.add_argument("--calibration", required=True, help="station calibration YAML, or a shipped station name")
-    p.add_argument("--tol-mm", type=option(TOL_MM), default=1.0,
-                   help=f"{TOL_MM.expected()} (default 1)")
-    p.add_argument("--tol-deg", type=option(TOL_DEG), default=0.5,
-                   help=f"{TOL_DEG.expected()} (default 0.5)")
+    ref = p.add_mutually_exclusive_group(required=True)
+    ref.add_argument("--calibration", help="station calibration YAML, or a shipped station name: check against its "
+                                           "intended poses")
+    ref.add_argument("--fit", action="store_true",
+                     help="audit the table on its own: fit the station grid to its entries robustly")
+    p.add_argument("--base", metavar="CALIBRATION",
+                   help="with --fit: the calibration giving robot base, tool and home (default lab_sim for "
+                        "sim_pos, lab_real for real_pos)")
+    p.add_argument("--tol-mm", type=option(TOL_MM), default=None,
+                   help=f"{TOL_MM.expected()} (default 1 with --calibration, derived from the data with --fit)")
+    p.add_argument("--tol-deg", type=option(TOL_DEG), default=None,
+                   help=f"{TOL_DEG.expected()} (default 0.5 with --calibration, derived from the data with --fit)")
+    p.add_argument("--json", action="store_true", help="print one JSON object: entries, suspects, fit")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from ur3hanoi.labfile import read_table
+    from ur3hanoi.audit import STRICT_DEG, STRICT_MM, audit_table, check_against, default_base
+    from ur3hanoi.labfile import read_recorded_table
     from ur3hanoi.station import load_station
-    from ur3hanoi.waypoints import check_table
 
-    station = load_station(args.calibration)
-    q = read_table(args.file, args.key)
-    rows = check_table(q, station, args.tol_mm, args.tol_deg, where=f"{args.file}:{args.key}")
-    print(f"{'tower':>5} {'height':>6} {'pose':>5} {'pos [mm]':>10} {'rot [deg]':>10}  status")
-    for r in rows:
-        status = "ok" if r.ok else "FAIL"
-        print(f"{r.tower:>5} {r.height:>6} {('on', 'above')[r.k]:>5} {r.position_error_mm:>10.4f} "
-              f"{r.orientation_error_deg:>10.4f}  {status}")
-    bad = [r for r in rows if not r.ok]
-    worst_mm = max(r.position_error_mm for r in rows)
-    worst_deg = max(r.orientation_error_deg for r in rows)
-    print(f"{len(rows) - len(bad)}/{len(rows)} entries within {args.tol_mm} mm / {args.tol_deg} deg "
-          f"(worst {worst_mm:.4f} mm, {worst_deg:.4f} deg)")
-    return exit_codes.OVER_TOLERANCE if bad else exit_codes.OK
+    if args.base is not None and not args.fit:
+        raise UsageError("--base is only used with --fit")
+    table = read_recorded_table(args.file, args.key)
+    if args.fit:
+        base = load_station(args.base or default_base(args.key))
+        report = audit_table(table, base, args.tol_mm, args.tol_deg)
+    else:
+        station = load_station(args.calibration)
+        tol_mm = STRICT_MM if args.tol_mm is None else args.tol_mm
+        tol_deg = STRICT_DEG if args.tol_deg is None else args.tol_deg
+        report = check_against(table, station, tol_mm, tol_deg)
+    print(json.dumps(report.to_json()) if args.json else report.text())
+    return exit_codes.OVER_TOLERANCE if report.failed else exit_codes.OK

@@ -222,11 +222,13 @@ def run(args: argparse.Namespace) -> int:
     station = load_station(cal)
     table = None
     if args.table is not None:
-        from ur3hanoi.labfile import read_table
+        from ur3hanoi.labfile import read_recorded_table
         from ur3hanoi.plan import check_table_shape
 
         inputs.append(Path(args.table))
-        table = read_table(args.table, args.key)
+        # Entries may be missing (null, or no "above" list) as students record them: NaN rows, and the plan
+        # names every missing entry the solve would visit.
+        table = read_recorded_table(args.table, args.key).q
         check_table_shape(table, station, f"{args.table}:{args.key}")
     n_towers = station.n_towers
     n_blocks = station.n_heights if args.blocks is None else args.blocks

@@ -115,6 +115,16 @@ class ListOf:
 
 
 @dataclass(frozen=True)
+class Nullable:
+    """``null`` (a value left out on purpose, e.g. an entry not recorded) or a value checked by ``item``."""
+
+    item: Spec
+
+    def expected(self) -> str:
+        return f"{self.item.expected()}, or null"
+
+
+@dataclass(frozen=True)
 class Field:
     """One key of a :class:`Record`."""
 
@@ -132,7 +142,7 @@ class Record:
         return f"a mapping with keys {', '.join(self.fields)}"
 
 
-Spec = Number | Vector | Choice | Text | ListOf | Record
+Spec = Number | Vector | Choice | Text | ListOf | Nullable | Record
 
 
 def _join(path: str, key: str) -> str:
@@ -179,6 +189,9 @@ class _Validator:
         elif isinstance(spec, Text):
             if not spec.accepts(value):
                 raise self.fail(path, value, spec.expected())
+        elif isinstance(spec, Nullable):
+            if value is not None:
+                self.check(value, spec.item, path)
         elif isinstance(spec, ListOf):
             if not isinstance(value, list) or not spec.min_items <= len(value) <= spec.max_items:
                 raise self.fail(path, value, spec.expected())

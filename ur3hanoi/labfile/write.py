@@ -1,136 +1,23 @@
-"""The lab's table file ``lab2_data.yaml``: strict reading, and in-place updates of one key.
-
-File format (the course's): top-level keys ``sim_pos`` / ``real_pos``, each ``Q[tower][height][k]`` with six joint
-angles [rad] (controller convention), ``k = 0`` the contact ("on") pose and ``k = 1`` the pose above it; plus
-``block_xy_pos[tower][height] = [x, y]`` [m, world] for the flat simulator layout. Any other key, a key given twice,
-or a value of the wrong shape or range is refused (:data:`LAB_FILE_SCHEMA`).
-
-Writing (:func:`write_table`) replaces only the keys it generates: every other key keeps its exact text, the bytes
-are a pure function of the inputs, and the read-modify-write holds a lock and ends in an atomic replace
-(:mod:`ur3hanoi.io.atomic`), so concurrent writers of different keys never lose one.
-"""
+"""Writing one key of a lab table file: format it, splice it into the file keeping every other key's text, and
+replace the file atomically under a lock (see :mod:`ur3hanoi.labfile`)."""
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from ur3hanoi import __version__
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.errors import TableError, printable, quote
+from ur3hanoi.errors import TableError, printable
 from ur3hanoi.grid import block_xy_pos
 from ur3hanoi.io.atomic import locked_output
-from ur3hanoi.io.schema import Field, ListOf, Number, Record, Spec, Vector
-from ur3hanoi.io.schema import validate as validate_schema
-from ur3hanoi.io.yaml_loader import load_yaml_file, parse_yaml
+from ur3hanoi.io.yaml_loader import parse_yaml
+from ur3hanoi.labfile.read import BLOCK_XY_KEY, WHAT, LabFile, check_key, read_lab_file, validate_lab_data
 from ur3hanoi.resources import station_file
-from ur3hanoi.robot import N_JOINTS
-from ur3hanoi.station import MAX_HEIGHTS, MAX_TOWERS
 from ur3hanoi.waypoints import Table, pose_label
-
-TABLE_KEYS: tuple[str, ...] = ("sim_pos", "real_pos")
-BLOCK_XY_KEY = "block_xy_pos"
-WHAT = "lab table file"
-
-JOINT_ANGLE = Number(-2 * math.pi, 2 * math.pi, unit="rad", what="a joint angle")
-Q_SCHEMA: Spec = ListOf(
-    ListOf(ListOf(Vector(N_JOINTS, JOINT_ANGLE), 2, 2, what="poses [on, above]"), 1, MAX_HEIGHTS, what="heights"),
-    1, MAX_TOWERS, what="towers",
-)
-"""``Q[tower][height][k]``: 1..10 towers of 1..20 heights of [on, above] poses of 6 joint angles [rad]."""
-
-BLOCK_XY_SCHEMA: Spec = ListOf(
-    ListOf(Vector(2, Number(-10.0, 10.0, unit="m", what="a coordinate")), 1, MAX_HEIGHTS, what="heights"),
-    1, MAX_TOWERS, what="towers",
-)
-"""``block_xy_pos[tower][height] = [x, y]`` [m, world]."""
-
-LAB_FILE_SCHEMA = Record({
-    "sim_pos": Field(Q_SCHEMA, required=False),
-    "real_pos": Field(Q_SCHEMA, required=False),
-    BLOCK_XY_KEY: Field(BLOCK_XY_SCHEMA, required=False),
-})
-"""The lab table file's schema: these three keys, each optional, nothing else."""
-
-
-# ---------------------------------------------------------------------------------------------------- reading
-
-
-@dataclass(frozen=True)
-class LabFile:
-    """A validated lab table file: ``data`` (key -> value), its ``text`` and the sha256 of its bytes."""
-
-    data: dict[str, Any]
-    text: str
-    sha256: str
-
-
-def _validate(data: Any, source: str) -> dict[str, Any]:
-    if data is None:
-        return {}
-    validate_schema(data, LAB_FILE_SCHEMA, source, TableError)
-    for key in (*TABLE_KEYS, BLOCK_XY_KEY):
-        if key in data:
-            _check_rectangular(data[key], source, key)
-    return dict(data)
-
-
-def _check_rectangular(value: list[list[Any]], source: str, key: str) -> None:
-    n_h = len(value[0])
-    for t, tower in enumerate(value):
-        if len(tower) != n_h:
-            raise TableError.invalid(source, f"{key}[{t}]", tower,
-                                     f"{n_h} heights like {key}[0] (every tower has the same number of heights)")
-
-
-def read_lab_file(path: str | Path, source: str | None = None) -> LabFile:
-    """Read and validate a lab table file (strict YAML, :data:`LAB_FILE_SCHEMA`); ``source`` names it in messages.
-
-    Raises:
-        TableError: unreadable, not strict YAML, or not matching the schema; the message names file and field.
-    """
-    source = str(path) if source is None else source
-    doc = load_yaml_file(path, what=WHAT, error=TableError, source=source)
-    return LabFile(data=_validate(doc.data, source), text=doc.text, sha256=doc.sha256)
-
-
-def parse_q(value: Any, source: str, key: str) -> FloatArray:
-    """Validate ``value`` as ``Q[tower][height][k][6]`` (field ``key`` of ``source``); shape (T, H, 2, 6) [rad]."""
-    validate_schema(value, Q_SCHEMA, source, TableError, path=key)
-    _check_rectangular(value, source, key)
-    return np.array(value, dtype=float)
-
-
-def read_table(path: str | Path, key: str) -> FloatArray:
-    """``Q`` of ``key`` in a lab table file as an array (T, H, 2, 6) [rad].
-
-    Raises:
-        TableError: the file is invalid (see :func:`read_lab_file`) or has no ``key``.
-    """
-    return table_of(read_lab_file(path), path, key)
-
-
-def _check_key(key: str) -> None:
-    if key not in TABLE_KEYS:
-        raise TableError(f"table key {quote(key)} is invalid: expected one of {', '.join(TABLE_KEYS)}")
-
-
-def table_of(lab: LabFile, path: str | Path, key: str) -> FloatArray:
-    """``Q`` of ``key`` in an already read :class:`LabFile` (read from ``path``)."""
-    _check_key(key)
-    if key not in lab.data:
-        present = ", ".join(k for k in lab.data if k in TABLE_KEYS) or "none"
-        raise TableError(f"{printable(path)}: key '{key}' not found (table keys present: {present})")
-    return np.array(lab.data[key], dtype=float)
-
-
-# ---------------------------------------------------------------------------------------------------- writing
 
 
 def _num(x: float) -> str:
@@ -157,7 +44,7 @@ def format_xy(xy: Sequence[Sequence[Sequence[float]]]) -> str:
             prefix = "- " if h == 0 else "  "
             # Rounded to 1e-10 m: exact enough, and reads 0.3 rather than 0.30000000000000004.
             x, y = (round(float(v), 10) for v in p[:2])
-            lines.append(f"{prefix}- [{_num(x)}, {_num(y)}]  # tower {t} height {h} [m, world]")
+            lines.append(f"{prefix}- [{_num(x)}, {_num(y)}]  # tower {t + 1} height {h + 1} [m, world]")
     return "\n".join(lines) + "\n"
 
 
@@ -253,7 +140,7 @@ def write_table(path: str | Path, table: Table, key: str, calibration_label: str
         OutputError: ``path`` cannot be written (an input file, a directory, a device, no space...).
         In both cases the file is left byte-identical.
     """
-    _check_key(key)
+    check_key(key)
     st = table.station
     label = calibration_label or st.source
     sections = {key: format_q(table.q, key)}
@@ -273,7 +160,7 @@ def _check_read_back(text: str, old: LabFile, sections: Mapping[str, str], key: 
                      source: str) -> None:
     """Refuse to write anything that does not read back exactly: other keys equal, ours as generated."""
     try:
-        new_data = _validate(parse_yaml(text, source, what=WHAT, error=TableError), source)
+        new_data = validate_lab_data(parse_yaml(text, source, what=WHAT, error=TableError), source)
     except TableError as exc:
         raise TableError(f"{printable(source)}: cannot update '{key}' in place (unusual YAML layout: {exc}); file "
                          "left unchanged") from None
@@ -285,17 +172,4 @@ def _check_read_back(text: str, old: LabFile, sections: Mapping[str, str], key: 
         raise TableError(f"{printable(source)}: '{key}' does not read back exactly; file left unchanged")
 
 
-__all__ = [
-    "BLOCK_XY_KEY",
-    "LAB_FILE_SCHEMA",
-    "TABLE_KEYS",
-    "LabFile",
-    "format_q",
-    "format_xy",
-    "parse_q",
-    "read_lab_file",
-    "read_table",
-    "splice_yaml",
-    "table_of",
-    "write_table",
-]
+__all__ = ["format_q", "format_xy", "splice_yaml", "write_table"]

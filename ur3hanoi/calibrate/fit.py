@@ -1,0 +1,419 @@
+"""Fit a station's grid to taught poses, robustly, and say which poses are suspect and why.
+
+:func:`fit_station` measures every pose by FK with the base calibration's robot base and tool
+(:mod:`~ur3hanoi.calibrate.grid_fit`), fits the grid with sequential leave-one-out deletion
+(:mod:`~ur3hanoi.calibrate.robust`), and explains each suspect (:mod:`~ur3hanoi.calibrate.explain`).
+
+Points that cannot take part in the fit are suspects from the start, never a reason to stop: a slot outside the
+base's grid, joint angles outside its limits, a tool tilted more than :data:`MAX_TILT_DEG` from pointing down. An
+"above" pose a table shares between the heights of a tower is not a grid point of any one height: it is checked
+to stand over the tower (its horizontal distance from the vertical through each contact point it serves) and at
+least one block above each of those contact points, and does not enter the fit.
+
+The fit fails (:class:`~ur3hanoi.errors.TaughtPointsError`) only when the remaining points do not determine the
+grid: at least one usable contact ("on") pose on every tower is needed, and above poses only count on towers that
+also have a contact pose. A fit whose result is doubtful is returned with :attr:`CalibrationFit.problem` set
+(:attr:`CalibrationFit.sound` False): more than half the points disagree with the grid, a point that cannot be left
+out is off, or the fitted grid itself is invalid. :func:`~ur3hanoi.calibrate.write_calibration` refuses to write
+it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ur3hanoi.arrays import FloatArray
+from ur3hanoi.calibrate.explain import diagnose
+from ur3hanoi.calibrate.grid_fit import (
+    BoolArray,
+    GridModel,
+    GridSolution,
+    Measured,
+    choose_model,
+    measure,
+)
+from ur3hanoi.calibrate.robust import RobustFit, Thresholds, robust_fit
+from ur3hanoi.errors import CalibrationError, TaughtPointsError, printable
+from ur3hanoi.grid import ABOVE, ON, POSE_NAMES
+from ur3hanoi.ik import wrap_angle
+from ur3hanoi.labfile import Slot
+from ur3hanoi.robot import load_ur3
+from ur3hanoi.station import Station
+from ur3hanoi.taught import TaughtPoint, TaughtPoints
+from ur3hanoi.waypoints import pose_label
+
+MAX_TILT_DEG = 10.0  # [deg] a taught pose's tool must point down within this to be used (tables use exactly down)
+MAX_APPROACH_M = 0.5  # [m] largest approach height a fit may give
+
+
+def _fail(source: str, msg: str) -> TaughtPointsError:
+    return TaughtPointsError(f"{printable(source)}: {msg}", source=source)
+
+
+@dataclass(frozen=True)
+class Suspect:
+    """A point that disagrees with the fitted grid.
+
+    Attributes:
+        index: the point's position in :attr:`CalibrationFit.points`.
+        tower, height, k: its slot, 0-based indices.
+        field: where it is in its file (``points[3]``, ``real_pos[1][2][0]``).
+        error_mm: its distance from the grid [mm] (the grid fitted without it); NaN when it has no grid slot.
+        severity: ``max(error / threshold_mm, orientation error / threshold_deg)``; suspects sort by it.
+        reason: why it is suspect and what probably happened, for people (towers and heights from 1).
+    """
+
+    index: int
+    tower: int
+    height: int
+    k: int
+    field: str
+    error_mm: float
+    severity: float
+    reason: str
+
+    @property
+    def label(self) -> str:
+        return pose_label(self.tower, self.height, self.k)
+
+
+@dataclass(frozen=True)
+class ResidualRow:
+    """One row of the residual report (one taught point). Lengths [mm], angles [deg]; ``tower``, ``height``
+    0-based indices."""
+
+    index: int
+    tower: int
+    height: int
+    pose: str
+    residual_mm: float
+    dx_mm: float
+    dy_mm: float
+    dz_mm: float
+    yaw_dev_deg: float
+    tilt_deg: float
+    flagged: bool
+    field: str = ""
+    status: str = "ok"
+
+
+@dataclass(frozen=True)
+class CalibrationFit:
+    """Result of :func:`fit_station`; everything a report or a notebook needs.
+
+    Attributes:
+        station: the fitted station (base calibration with the new grid and tool yaw).
+        points: the taught points, in input order.
+        measured: FK suction points, shape (N, 3) [m, world].
+        fitted: the fitted grid's suction points for the same slots, shape (N, 3) [m, world] (NaN rows for a
+            slot outside the grid; for a shared above pose, the nearest point over its tower).
+        residuals_mm: ``|measured - fitted|`` per point [mm], shape (N,).
+        yaw_dev_deg: each point's TCP heading minus the fitted tool yaw [deg], shape (N,).
+        tilt_deg: each point's tool tilt from pointing straight down [deg], shape (N,).
+        rot_deg: each point's orientation error from the grid pose [deg], shape (N,).
+        fitted_params: which grid parameters the points determined (others come from the base calibration).
+        dof: redundancy of the position fit (3 x points used minus the unknowns); 0 = exact fit.
+        used: shape (N,), the points the final fit used.
+        status: per point, ``"ok"`` or ``"suspect"``.
+        suspects: the suspect points, worst first.
+        thresholds: the suspect thresholds.
+        missing: the slots a table left empty ``(tower, height, k)`` (0-based).
+        problem: why the fit is not sound ("" when it is).
+        warnings: one line per suspect (``"<label>: <reason>"``) and the problem, if any.
+    """
+
+    station: Station
+    points: tuple[TaughtPoint, ...]
+    measured: FloatArray
+    fitted: FloatArray
+    residuals_mm: FloatArray
+    yaw_dev_deg: FloatArray
+    tilt_deg: FloatArray
+    rot_deg: FloatArray
+    fitted_params: tuple[str, ...]
+    dof: int
+    used: tuple[bool, ...]
+    status: tuple[str, ...]
+    suspects: tuple[Suspect, ...]
+    thresholds: Thresholds
+    missing: tuple[Slot, ...]
+    problem: str
+    warnings: tuple[str, ...]
+
+    @property
+    def sound(self) -> bool:
+        """True when the fit can be trusted to write a station (see the module docstring)."""
+        return not self.problem
+
+    @property
+    def n_used(self) -> int:
+        return int(sum(self.used))
+
+    @property
+    def rms_mm(self) -> float:
+        """Root mean square of the residuals of the points used [mm]."""
+        used = np.array(self.used)
+        return float(np.sqrt(np.mean(self.residuals_mm[used] ** 2))) if used.any() else math.nan
+
+    @property
+    def max_mm(self) -> float:
+        """Largest residual of the points used [mm]."""
+        used = np.array(self.used)
+        return float(np.max(self.residuals_mm[used])) if used.any() else math.nan
+
+    def residual_table(self) -> list[ResidualRow]:
+        """Per-point rows (``pandas.DataFrame(fit.residual_table())`` works)."""
+        d = (self.measured - self.fitted) * 1e3
+        return [
+            ResidualRow(index=p.index, tower=p.tower, height=p.height, pose=POSE_NAMES[p.k],
+                        residual_mm=float(self.residuals_mm[i]), dx_mm=float(d[i, 0]), dy_mm=float(d[i, 1]),
+                        dz_mm=float(d[i, 2]), yaw_dev_deg=float(self.yaw_dev_deg[i]),
+                        tilt_deg=float(self.tilt_deg[i]), flagged=self.status[i] == "suspect", field=p.where,
+                        status=self.status[i])
+            for i, p in enumerate(self.points)
+        ]
+
+
+# --------------------------------------------------------------------------------------------------- checks
+
+
+def _off_grid(base: Station, p: TaughtPoint) -> bool:
+    return not (0 <= p.tower < base.n_towers and 0 <= p.height < base.n_heights)
+
+
+def _hard_problems(base: Station, points: Sequence[TaughtPoint], m: Measured) -> list[str]:
+    """Per point, why it cannot take part in the fit ("" if it can)."""
+    out = []
+    for i, p in enumerate(points):
+        if not 0 <= p.tower < base.n_towers:
+            out.append(f"tower {p.tower + 1} is outside the base calibration's grid (towers 1..{base.n_towers} in "
+                       f"{printable(base.source)})")
+        elif not 0 <= p.height < base.n_heights:
+            out.append(f"height {p.height + 1} is outside the base calibration's grid (heights 1..{base.n_heights} "
+                       f"in {printable(base.source)})")
+        elif not base.limits.within_position(np.asarray(p.q, dtype=float)):
+            out.append(f"joint angles {np.round(np.degrees(p.q), 3).tolist()} deg are outside the joint limits of "
+                       f"{printable(base.source)}")
+        elif m.tilt_deg[i] > MAX_TILT_DEG:
+            out.append(f"the tool is tilted {m.tilt_deg[i]:.2f} deg from pointing down (more than "
+                       f"{MAX_TILT_DEG:g} deg: left out of the fit)")
+        else:
+            out.append("")
+    return out
+
+
+def _underdetermined(where: str, base: Station, points: Sequence[TaughtPoint], candidates: BoolArray,
+                     hard: Sequence[str]) -> TaughtPointsError:
+    """The "too little left to fit" error: what the grid needs, what is missing, what was left out."""
+    usable_on = {p.tower for i, p in enumerate(points) if candidates[i] and p.k == ON}
+    lacking = [t + 1 for t in range(base.n_towers) if t not in usable_on]
+    need = ("too little left to fit the grid: it needs a usable contact ('on') pose on every tower "
+            f"({base.n_towers} towers), and above poses count only on towers that also have one")
+    if lacking:
+        need += f"; tower(s) {', '.join(map(str, lacking))} have none"
+    left_out = [f"{p.label}: {hard[i]}" for i, p in enumerate(points) if hard[i]]
+    if left_out:
+        more = f" and {len(left_out) - 2} more" if len(left_out) > 2 else ""
+        need += f" (left out: {'; '.join(left_out[:2])}{more})"
+    if sum("tilted" in h for h in hard) > len(points) // 2:
+        need += f"; most poses are tilted: is the tool offset of {printable(base.source)} right?"
+    return _fail(where, need)
+
+
+# ------------------------------------------------------------------------------------------------- fitting
+
+
+def _station(base: Station, model: GridModel, solution: GridSolution, yaw: float, source: str
+             ) -> tuple[Station, str]:
+    """The fitted station, and the problem that makes it invalid ("" if none)."""
+    # Rounded to 1e-12 m (far below any physical meaning) so exact fits write 0.0 rather than -0.0 or 1e-17.
+    origins = np.round(solution.origins, 12) + 0.0
+    step = np.round(solution.step, 12) + 0.0
+    approach = round(solution.approach, 12) if model.fit_approach else base.approach
+    unvalidated = replace(base, tower_origins=tuple((float(x), float(y), float(z)) for x, y, z in origins),
+                          height_step=(float(step[0]), float(step[1]), float(step[2])), tool_yaw=float(yaw),
+                          approach=float(approach), source=source, sha256="")
+    if not 0.0 < approach <= MAX_APPROACH_M:
+        return unvalidated, (f"the fitted approach height {approach:.4f} m is outside (0, {MAX_APPROACH_M:g}] m: are "
+                             "some contact poses marked 'above' (or the reverse)?")
+    try:
+        return base.with_grid(origins, step, yaw, approach, source=source), ""
+    except CalibrationError as exc:
+        return unvalidated, (f"the fitted grid is invalid ({exc.allowed}; got {exc.field} = {exc.value}): check the "
+                             "tower/height labels of the points")
+
+
+def _shared_targets(station: Station, points: Sequence[TaughtPoint], m: Measured, shared: BoolArray) -> FloatArray:
+    """For each shared above pose: the nearest point that stands over its slot's contact point and at least one
+    block above it (NaN rows for the others)."""
+    out = np.full((len(points), 3), np.nan)
+    for i in np.flatnonzero(shared):
+        p = points[i]
+        contact = np.asarray(station.tower_origins[p.tower]) + p.height * np.asarray(station.height_step)
+        out[i] = [contact[0], contact[1], max(float(m.p_world[i, 2]), contact[2] + station.block_size)]
+    return out
+
+
+def _basis(points: Sequence[TaughtPoint], used: BoolArray, i: int) -> str:
+    """``"the 8 other contacts"`` / ``"the other 7 contacts and 9 above poses"``: what point ``i`` was compared
+    with."""
+    n_on = sum(1 for j, p in enumerate(points) if used[j] and j != i and p.k == ON)
+    n_above = sum(1 for j, p in enumerate(points) if used[j] and j != i and p.k == ABOVE)
+    if n_above == 0:
+        return f"the {n_on} other contacts"
+    if n_on == 0:
+        return f"the {n_above} other above poses"
+    return f"the other {n_on} contacts and {n_above} above poses"
+
+
+@dataclass(frozen=True)
+class _Context:
+    base: Station
+    points: tuple[TaughtPoint, ...]
+    m: Measured
+    fit: RobustFit
+    fitted: FloatArray
+    shared: BoolArray
+    hard: tuple[str, ...]
+    grid_points: dict[Slot, FloatArray]
+
+
+def _reasons(ctx: _Context, suspects: Sequence[int]) -> dict[int, str]:
+    """Why each suspect is suspect, and what probably happened."""
+    pts, m, th = ctx.points, ctx.m, ctx.fit.thresholds
+    gridded = [i for i in range(len(pts)) if not np.isnan(ctx.fitted[i]).any() and not ctx.shared[i]]
+    slots = [(p.tower, p.height, p.k) for p in pts]
+    where = {g: n for n, g in enumerate(gridded)}
+    what = diagnose(load_ur3(ctx.base.tool, ctx.base.limits), ctx.base.T_world_base, [slots[i] for i in gridded],
+                    [pts[i].q for i in gridded], m.p_world[gridded], ctx.fit.rot_deg[gridded], ctx.fitted[gridded],
+                    ctx.grid_points,
+                    [where[i] for i in suspects if i in where], ctx.fit.yaw, th.mm, th.deg,
+                    [f"{pts[i].label}" for i in gridded])
+    out: dict[int, str] = {}
+    for i in suspects:
+        p = pts[i]
+        if np.isnan(ctx.fitted[i]).any():
+            out[i] = ctx.hard[i]
+            continue
+        parts = []
+        dev = float(np.linalg.norm(m.p_world[i] - ctx.fitted[i])) * 1e3
+        if ctx.shared[i]:
+            heights = ", ".join(str(h + 1) for h in p.shared)
+            parts.append(f"the above pose shared by heights {heights} of tower {p.tower + 1} is {dev:.1f} mm from "
+                         "standing over this contact point at least one block above it")
+        elif ctx.fit.used[i] and not ctx.fit.removable[i]:
+            parts.append(f"{dev:.1f} mm from the grid (kept in the fit: the other points do not determine it without "
+                         "this one)")
+        else:
+            parts.append(f"{dev:.1f} mm from the grid fitted to {_basis(pts, ctx.fit.used, i)}")
+        if ctx.fit.rot_deg[i] > th.deg and m.tilt_deg[i] <= MAX_TILT_DEG:
+            yaw_dev = math.degrees(float(wrap_angle(m.heading[i] - ctx.fit.yaw)))
+            parts.append(f"the tool is turned {ctx.fit.rot_deg[i]:.1f} deg from the grid pose (tilt "
+                         f"{m.tilt_deg[i]:.1f} deg, heading {yaw_dev:+.1f} deg)")
+        if i in where:
+            parts.append(what[where[i]])
+        if ctx.hard[i]:
+            parts.append(ctx.hard[i])
+        out[i] = "; ".join(parts)
+    return out
+
+
+def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], name: str | None = None,
+                source: str = "<memory>", tol_mm: float | None = None, tol_deg: float | None = None
+                ) -> CalibrationFit:
+    """Fit the grid of ``base`` (tower origins, height step, approach, tool yaw) to taught poses, robustly.
+
+    Args:
+        base: calibration providing everything not fitted (robot base, tool offset, blocks, home, counts, layout).
+        taught: the taught points (joint angles [rad]).
+        name: name of the new station (default: the base's).
+        source: recorded as the new station's ``source`` (the output file's path).
+        tol_mm, tol_deg: fixed suspect thresholds [mm], [deg] instead of the ones derived from the data (see
+            :mod:`ur3hanoi.calibrate.robust`).
+
+    Raises:
+        TaughtPointsError: no points, a table whose shape is not the base's grid, or too little left to fit.
+    """
+    if isinstance(taught, TaughtPoints):
+        points, where, missing, shape = taught.points, taught.source, taught.missing, taught.shape
+    else:
+        points, where, missing, shape = tuple(taught), "<memory>", (), None
+    if not points:
+        raise _fail(where, "no taught points")
+    if shape is not None and shape != (base.n_towers, base.n_heights):
+        raise _fail(where, f"the table has {shape[0]} towers x {shape[1]} heights, the base calibration "
+                           f"{printable(base.source)} {base.n_towers} x {base.n_heights}: use a base with the table's "
+                           "grid")
+
+    m = measure(base, [p.q for p in points])
+    hard = tuple(_hard_problems(base, points, m))
+    shared = np.array([bool(p.shared) and not hard[i] for i, p in enumerate(points)])
+    candidates = np.array([not hard[i] and not shared[i] for i in range(len(points))])
+    slots = [(p.tower, p.height, p.k) for p in points]
+    model = choose_model(base, [s for s, c in zip(slots, candidates, strict=True) if c])
+    if model is None:
+        raise _underdetermined(where, base, points, candidates, hard)
+    # Points outside the grid take no part; they get placeholder slots (never used) so arrays stay aligned.
+    off_grid = np.array([_off_grid(base, p) for p in points])
+    safe_slots = [(0, 0, ON) if off_grid[i] else s for i, s in enumerate(slots)]
+    fit = robust_fit(base, model, safe_slots, m, candidates, tol_mm, tol_deg)
+    station, problem = _station(base, model, fit.solution, fit.yaw, source)
+    if name is not None:
+        station = replace(station, name=name)
+
+    fitted = fit.solution.points(safe_slots)
+    fitted[off_grid] = np.nan
+    shared_t = _shared_targets(station, points, m, shared)
+    fitted[shared] = shared_t[shared]
+    residuals = np.linalg.norm(m.p_world - fitted, axis=1) * 1e3
+    # Shared poses and points left out are judged by their distance from the final grid.
+    dev_mm = np.where(fit.used & fit.removable, fit.deviation_mm, residuals)
+    severity = np.maximum(dev_mm / fit.thresholds.mm, fit.rot_deg / fit.thresholds.deg)
+    is_suspect = (~fit.used & candidates) | (severity > 1.0) | np.array([bool(h) for h in hard])
+    grid_points = {(t, h, k): fit.solution.point((t, h, k)) for t in range(base.n_towers)
+                   for h in range(base.n_heights) for k in (ON, ABOVE)}
+    ctx = _Context(base=base, points=points, m=m, fit=fit, fitted=fitted, shared=shared, hard=hard,
+                   grid_points=grid_points)
+    order = sorted(np.flatnonzero(is_suspect), key=lambda i: -np.nan_to_num(severity[i], nan=np.inf))
+    reasons = _reasons(ctx, [int(i) for i in order])
+    suspects = tuple(
+        Suspect(index=int(i), tower=points[i].tower, height=points[i].height, k=points[i].k, field=points[i].where,
+                error_mm=float(residuals[i]), severity=float(np.nan_to_num(severity[i], nan=np.inf)),
+                reason=reasons[int(i)])
+        for i in order)
+
+    if not problem:
+        problem = _soundness(fit, candidates, dev_mm)
+    warnings = [f"{s.label} [{s.field}]: {s.reason}" for s in suspects]
+    if problem:
+        warnings.append(f"the fit is not sound: {problem}")
+    yaw_dev = np.degrees(wrap_angle(m.heading - fit.yaw))
+    idx = np.flatnonzero(fit.used)
+    return CalibrationFit(
+        station=station, points=points, measured=m.p_world, fitted=fitted, residuals_mm=residuals,
+        yaw_dev_deg=yaw_dev, tilt_deg=m.tilt_deg, rot_deg=fit.rot_deg, fitted_params=model.params,
+        dof=3 * len(idx) - model.n_unknowns, used=tuple(bool(u) for u in fit.used),
+        status=tuple("suspect" if s else "ok" for s in is_suspect), suspects=suspects, thresholds=fit.thresholds,
+        missing=missing, problem=problem, warnings=tuple(warnings),
+    )
+
+
+def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray) -> str:
+    """Why the remaining fit cannot be trusted ("" if it can)."""
+    n = int(candidates.sum())
+    left_out = int((candidates & ~fit.used).sum())
+    over = fit.used & (dev_mm > fit.thresholds.mm)
+    if left_out >= max(1, (n - 1) // 2) and over.any():
+        return (f"{left_out} of {n} points left out and more still disagree with the grid: check the base "
+                "calibration's robot base and tool, and the tower/height labels")
+    if over.any():
+        return (f"{int(over.sum())} point(s) the fit cannot do without are more than {fit.thresholds.mm:.1f} mm off "
+                "the grid: re-record them or add points")
+    return ""
+
+
+__all__ = ["MAX_TILT_DEG", "CalibrationFit", "ResidualRow", "Suspect", "fit_station"]

@@ -1,0 +1,65 @@
+"""The lab's table file ``lab2_data.yaml``: strict reading, and in-place updates of one key.
+
+File format (the course's): top-level keys ``sim_pos`` / ``real_pos``, each ``Q[tower][height][k]`` with six joint
+angles [rad] (controller convention), ``k = 0`` the contact ("on") pose and ``k = 1`` the pose above it; plus
+``block_xy_pos[tower][height] = [x, y]`` [m, world] for the flat simulator layout. Any other key, a key given twice,
+or a value of the wrong shape or range is refused (:data:`LAB_FILE_SCHEMA`). The list indices are 0-based, as the
+lab defines them; everything ur3hanoi shows people numbers towers and heights from 1 (``Q[0][2][1]`` is "tower 1
+height 3 above").
+
+Tables recorded by hand are often incomplete, and the schema accepts what students write:
+
+- a missing entry: ``null`` for a pose (``Q[t][h][k]``), a slot (``Q[t][h]``) or a whole tower (``Q[t]``);
+- a slot with only its contact pose, ``Q[t][h] = [on]`` (the "above" pose left out);
+- one "above" pose shared by the heights of a tower: the same six numbers in ``Q[t][h][1]`` for several ``h``
+  (copied, or one YAML anchor ``&above_A`` used through aliases ``*above_A``). Shared means bit-identical values in
+  one tower; the file is represented as it is (one entry per slot) and :attr:`RecordedTable.shared_above` names
+  the groups.
+
+:func:`read_recorded_table` returns what is present (:class:`RecordedTable`, a masked array); :func:`read_table` is
+for consumers that need every entry and refuses an incomplete table, naming the missing entries.
+
+Writing (:func:`write_table`) replaces only the keys it generates: every other key keeps its exact text, the bytes
+are a pure function of the inputs, and the read-modify-write holds a lock and ends in an atomic replace
+(:mod:`ur3hanoi.io.atomic`), so concurrent writers of different keys never lose one.
+
+Module map: :mod:`~ur3hanoi.labfile.read` (schema, strict reading, :class:`RecordedTable`) and
+:mod:`~ur3hanoi.labfile.write` (formatting a key, splicing it into the file, the locked atomic update).
+"""
+
+from __future__ import annotations
+
+from ur3hanoi.labfile.read import (
+    BLOCK_XY_KEY,
+    LAB_FILE_SCHEMA,
+    TABLE_KEYS,
+    LabFile,
+    RecordedTable,
+    Slot,
+    parse_q,
+    read_lab_file,
+    read_recorded_table,
+    read_table,
+    recorded_table_of,
+    table_of,
+)
+from ur3hanoi.labfile.write import format_q, format_xy, splice_yaml, write_table
+
+__all__ = [
+    "BLOCK_XY_KEY",
+    "LAB_FILE_SCHEMA",
+    "TABLE_KEYS",
+    "LabFile",
+    "RecordedTable",
+    "Slot",
+    "format_q",
+    "format_xy",
+    "parse_q",
+    "read_lab_file",
+    "read_recorded_table",
+    "read_table",
+    "recorded_table_of",
+    "splice_yaml",
+    "table_of",
+    "write_table",
+]
