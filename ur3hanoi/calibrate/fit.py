@@ -364,20 +364,34 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
     station, problem = _station(base, model, fit.solution, fit.yaw, source)
     if name is not None:
         station = replace(station, name=name)
+    ctx = _judged(base, station, points, m, fit, safe_slots, off_grid, shared, hard)
+    return _calibration_fit(ctx, station, model, candidates, missing, problem)
 
+
+def _judged(base: Station, station: Station, points: Sequence[TaughtPoint], m: Measured, fit: RobustFit,
+            safe_slots: Sequence[tuple[int, int, int]], off_grid: BoolArray, shared: BoolArray,
+            hard: tuple[str, ...]) -> _Context:
+    """Every point against the fitted grid: where the grid puts it (shared "above" poses and off-grid points by
+    the final station), its deviation, and the context the explanations need."""
     fitted = fit.solution.points(safe_slots)
     fitted[off_grid] = np.nan
     shared_t = _shared_targets(station, points, m, shared)
     fitted[shared] = shared_t[shared]
+    grid_points = {(t, h, k): fit.solution.point((t, h, k)) for t in range(base.n_towers)
+                   for h in range(base.n_heights) for k in (ON, ABOVE)}
+    return _Context(base=base, points=tuple(points), m=m, fit=fit, fitted=fitted, shared=shared, hard=hard,
+                    grid_points=grid_points)
+
+
+def _calibration_fit(ctx: _Context, station: Station, model: GridModel, candidates: BoolArray,
+                     missing: tuple[Slot, ...], problem: str) -> CalibrationFit:
+    """The suspects (worst first, each with its reason), the soundness verdict and the report of the fit."""
+    points, m, fit, fitted = ctx.points, ctx.m, ctx.fit, ctx.fitted
     residuals = np.linalg.norm(m.p_world - fitted, axis=1) * 1e3
     # Shared poses and points left out are judged by their distance from the final grid.
     dev_mm = np.where(fit.used & fit.removable, fit.deviation_mm, residuals)
     severity = np.maximum(dev_mm / fit.thresholds.mm, fit.rot_deg / fit.thresholds.deg)
-    is_suspect = (~fit.used & candidates) | (severity > 1.0) | np.array([bool(h) for h in hard])
-    grid_points = {(t, h, k): fit.solution.point((t, h, k)) for t in range(base.n_towers)
-                   for h in range(base.n_heights) for k in (ON, ABOVE)}
-    ctx = _Context(base=base, points=points, m=m, fit=fit, fitted=fitted, shared=shared, hard=hard,
-                   grid_points=grid_points)
+    is_suspect = (~fit.used & candidates) | (severity > 1.0) | np.array([bool(h) for h in ctx.hard])
     order = sorted(np.flatnonzero(is_suspect), key=lambda i: -np.nan_to_num(severity[i], nan=np.inf))
     reasons = _reasons(ctx, [int(i) for i in order])
     suspects = tuple(
@@ -394,7 +408,7 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
     yaw_dev = np.degrees(wrap_angle(m.heading - fit.yaw))
     idx = np.flatnonzero(fit.used)
     return CalibrationFit(
-        station=station, points=points, measured=m.p_world, fitted=fitted, residuals_mm=residuals,
+        station=station, points=tuple(points), measured=m.p_world, fitted=fitted, residuals_mm=residuals,
         yaw_dev_deg=yaw_dev, tilt_deg=m.tilt_deg, rot_deg=fit.rot_deg, fitted_params=model.params,
         dof=3 * len(idx) - model.n_unknowns, used=tuple(bool(u) for u in fit.used),
         status=tuple("suspect" if s else "ok" for s in is_suspect), suspects=suspects, thresholds=fit.thresholds,
