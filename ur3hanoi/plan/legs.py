@@ -57,7 +57,7 @@ DENSE_RATE_HZ = 1000.0  # [Hz] rate of the forward-kinematics check of every leg
 # [m] kept free below the tolerance at the 1 kHz samples: between two samples the suction point moves sideways by
 # at most its lateral speed (< 0.05 m/s on a leg) times 0.5 ms, i.e. 25 um.
 DENSE_MARGIN_M = 5e-5
-CONTACT_OVERSHOOT_M = 1e-4  # [m] a leg may dip this far below the contact pose (Ruckig's synchronised joints)
+CONTACT_OVERSHOOT_M = 5e-4  # [m] a leg may dip this far below the contact pose (see the module docstring)
 INTERIOR_FRACTIONS: tuple[tuple[float, ...], ...] = ((0.65,), (1 / 3, 2 / 3))  # tried in order, of the approach
 LOWER_BOUND_RTOL = 1e-3  # the interior search stops within this of the single-segment lower bound
 # Start of the one-point search, in units (vb, vb / T0): the optima of the lab stations' legs lie at 1.7-1.95 vb
@@ -65,6 +65,10 @@ LOWER_BOUND_RTOL = 1e-3  # the interior search stops within this of the single-s
 ONE_POINT_GUESS = (1.8, -3.0)
 SEARCH_STEP = (0.05, 0.5)  # initial simplex of the search, same units
 MAX_EVALS = 40  # cost evaluations of the search per interior point
+# Numbers of interior points of the path-profile legs (see _profile_legs), tried in order; they are spaced
+# quadratically toward the contact pose, where the joint path curves most (near the arm's singularities).
+PROFILE_POINTS = (4, 6, 8, 12)
+OVERSHOOT_BOUND_M = 5e-3  # [m] a single segment overshooting the contact pose by more marks its cell infeasible
 
 
 @dataclass(frozen=True)
@@ -146,8 +150,8 @@ class SlotLegs:
 
     def lower_bound(self, cell: Cell) -> float:
         """Duration [s] of the single joint-space segment from the cell's above state to rest on: a lower bound of
-        its leg (inf: the state is outside the limits, Ruckig fails, or the segment dips below the contact pose,
-        which a leg through interior points would then do too)."""
+        its leg (inf: the state is outside the limits, Ruckig fails, or the segment overshoots the contact pose by
+        more than :data:`OVERSHOOT_BOUND_M`: the state cannot brake within the approach)."""
         return self._lower_bound(cell)[0]
 
     def _lower_bound(self, cell: Cell) -> tuple[float, RuckigTrajectory | None]:
@@ -158,7 +162,7 @@ class SlotLegs:
             if traj is not None and cell != self.rest_cell:
                 tau = np.linspace(0.0, traj.duration, 25)
                 z = tcp_positions_world(self.station, evaluate(traj, tau)[0])[:, 2]
-                ok = float(np.min(z)) >= self.z_on - CONTACT_OVERSHOOT_M
+                ok = float(np.min(z)) >= self.z_on - OVERSHOOT_BOUND_M
             self._lower[cell] = (traj.duration, traj) if ok and traj is not None else (math.inf, None)
         return self._lower[cell]
 
@@ -189,14 +193,18 @@ class SlotLegs:
 
     def _build(self, cell: Cell) -> tuple[Leg, Leg] | None:
         lb, traj = self._lower_bound(cell)
-        if traj is not None:
-            for fractions in INTERIOR_FRACTIONS:
-                legs, hopeless = self._through_points(cell, lb, traj, fractions)
-                if legs is not None:
-                    return legs
-                if hopeless:
-                    break
-        return self._exact_path_legs() if cell == self.rest_cell else None
+        if traj is None:
+            return self._exact_path_legs() if cell == self.rest_cell else None
+        for fractions in INTERIOR_FRACTIONS:
+            legs, hopeless = self._through_points(cell, lb, traj, fractions)
+            if legs is not None:
+                return legs
+            if hopeless:
+                break
+        legs = self._profile_legs(cell)
+        if legs is None and cell == self.rest_cell:
+            legs = self._exact_path_legs()
+        return legs
 
     def _points(self, fractions: Sequence[float]) -> list[tuple[FloatArray, FloatArray, FloatArray]]:
         """(q, dq/ds, d2q/ds2) of the path at each interior point."""
@@ -267,6 +275,52 @@ class SlotLegs:
             legs.append(Leg(tuple(states), tuple(chain), sum(t.duration for t in chain), dev))
         return (legs[0], legs[1]), False
 
+    def _verified(self, states: Sequence[State]) -> Leg | None:
+        """The chained leg through ``states`` if Ruckig solves it and it passes the corridor check, else None."""
+        chain = self._chain(states)
+        if chain is None:
+            return None
+        dev, dip = self.corridor(chain)
+        if dip > CONTACT_OVERSHOOT_M or dev > self.tol_m - DENSE_MARGIN_M:
+            return None
+        return Leg(tuple(states), tuple(chain), sum(t.duration for t in chain), dev)
+
+    def _profile_legs(self, cell: Cell) -> tuple[Leg, Leg] | None:
+        """Legs through many interior points whose states come from the exact path-following timing (a 1-DoF
+        Ruckig of s under :class:`PathLimits`, entering at the cell's via state): for slots where the joint path
+        curves too much for one or two points. Each joint-space segment is at least as fast as the path timing
+        between its points, and with :data:`PROFILE_POINTS` points it stays on the line; no search."""
+        pl = self._path_limits()
+        sigma, acc = self.speeds[cell[0]], self.accels[cell[1]]
+        L = self.path.length_m
+        if sigma > pl.v or abs(acc) > pl.a:
+            return None
+        sol = OfflineRuckig([pl.v], [pl.a], [pl.j]).solve([0.0], [sigma], [acc], [L], [0.0], [0.0])
+        traj = sol.trajectory
+        if traj is None:
+            return None
+        tau = np.linspace(0.0, traj.duration, 4001)
+        s, sd, sdd = (x[:, 0] for x in evaluate(traj, tau))
+        if float(np.min(s)) < -1e-12 or float(np.max(s)) > L + 1e-12:
+            return None
+        for n in PROFILE_POINTS:
+            mid = []
+            for k in range(n):
+                i = min(int(np.searchsorted(s, (1.0 - ((n - k) / (n + 1)) ** 2) * L)), len(s) - 1)
+                q, dq, ddq, _ = self.path.evaluate(float(s[i]))
+                mid.append((q, sd[i] * dq, sd[i] * sd[i] * ddq + sdd[i] * dq))
+            if not all(within_limits(m, self.limits) for m in mid):
+                continue
+            down = self._verified([self.above_state(cell, down=True), *mid, self.on])
+            rev = [(q, -v, a) for q, v, a in mid[::-1]]
+            up = self._verified([self.on, *rev, self.above_state(cell, down=False)]) if down is not None else None
+            if down is not None and up is not None:
+                return down, up
+        return None
+
+    def _path_limits(self) -> PathLimits:
+        return PathLimits.for_path(self.path, self.limits)
+
     def corridor(self, chain: Sequence[RuckigTrajectory]) -> tuple[float, float]:
         """(worst distance [m] from the vertical line, deepest dip [m] below the contact pose) of chained joint
         trajectories, by forward kinematics at :data:`DENSE_RATE_HZ` (each segment from its start, and its end)."""
@@ -278,7 +332,7 @@ class SlotLegs:
 
     def _exact_path_legs(self) -> tuple[Leg, Leg]:
         """Rest-to-rest legs following the line exactly: a 1-DoF Ruckig of s under :class:`PathLimits`."""
-        pl = PathLimits.for_path(self.path, self.limits)
+        pl = self._path_limits()
         rk = OfflineRuckig([pl.v], [pl.a], [pl.j])
         L = self.path.length_m
         z = [0.0]
