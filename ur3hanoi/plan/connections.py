@@ -8,9 +8,9 @@ from :class:`~ur3hanoi.plan.legs.SlotLegs`.
 
 :func:`station_planner` returns the :class:`StationPlanner` of a station and its planning limits, built once and
 cached (least recently used, a few stations): its legs, connections and reference durations are memoized. Every
-entry is a pure function of its key, and the keys hold the whole calibration (the :class:`Station` value, compared
-field by field) and the limits, so a changed calibration can never reuse a stale entry, and the results do not
-depend on what was planned before.
+entry is a pure function of its key, and the keys hold the whole calibration geometry (the :class:`Station` value,
+compared field by field, without its name and file) and the limits, so a changed calibration can never reuse a
+stale entry, and the results do not depend on what was planned before.
 """
 
 from __future__ import annotations
@@ -32,14 +32,14 @@ from ur3hanoi.plan.ruckig import OfflineRuckig
 from ur3hanoi.plan.types import KinematicLimits
 from ur3hanoi.plan.vertical import PathLimits, line_ik
 from ur3hanoi.plan.via import Pair, best_cells
-from ur3hanoi.plan.waypoints import Waypoints, build_waypoints
+from ur3hanoi.plan.waypoints import Waypoints, build_waypoints, geometry_key
 from ur3hanoi.robot import N_JOINTS, load_ur3
 from ur3hanoi.station import Station
 
 Slot = tuple[int, int]  # (tower, height), 0-based
 
 # Start of the via search, in the grid's units (vb, vb / T0): near the optimum of the lab stations' connections.
-SEARCH_START = (1.5, 2.0)
+SEARCH_START = (2.25, 2.0)
 
 
 @dataclass(frozen=True)
@@ -286,7 +286,8 @@ def _cached_planner(station: Station, v: tuple[float, ...], a: tuple[float, ...]
 
 def station_planner(station: Station, limits: KinematicLimits, tol_m: float, via_speeds: tuple[float, ...],
                     via_accels: tuple[float, ...], pass_through: bool = True, blend: bool = True) -> StationPlanner:
-    """The cached :class:`StationPlanner` of ``station`` under ``limits`` (keyed by every input's value)."""
-    return _cached_planner(station, tuple(limits.v_max.tolist()), tuple(limits.a_max.tolist()),
+    """The cached :class:`StationPlanner` of ``station`` under ``limits``, keyed by every input's value; of the
+    station, by its geometry only (its name, source file and file digest do not change a motion)."""
+    return _cached_planner(geometry_key(station), tuple(limits.v_max.tolist()), tuple(limits.a_max.tolist()),
                            tuple(limits.j_max.tolist()), float(tol_m), tuple(via_speeds), tuple(via_accels),
                            bool(pass_through), bool(blend))

@@ -15,7 +15,7 @@ from ur3hanoi.hanoi import Move, check_sequence, solve_hanoi
 from ur3hanoi.plan.baseline import exact_vertical_motion_s, stop_and_go_motion_s
 from ur3hanoi.plan.builder import SegmentBuilder, plan_hops
 from ur3hanoi.plan.checks import check_limits, check_vertical
-from ur3hanoi.plan.collision import check_collisions
+from ur3hanoi.plan.clearance import check_segments
 from ur3hanoi.plan.sampling import sample
 from ur3hanoi.plan.types import Plan, PlanConfig
 from ur3hanoi.plan.waypoints import build_waypoints
@@ -55,7 +55,7 @@ def plan_moves(station: Station, moves: Sequence[Move], config: PlanConfig | Non
     timings["checks"] = time.perf_counter() - t0
     if config.check_collisions and moves:
         t0 = time.perf_counter()
-        violations += check_collisions(tr, moves, station, n_blocks, start, config, limits)
+        violations += check_segments(segments, moves, station, n_blocks, start, config, limits)
         timings["collision"] = time.perf_counter() - t0
     duration = segments[-1].t_end
     plan = Plan(station=station, moves=tuple(moves), trajectory=tr, stop_and_go_duration_s=stop_go, config=config,
