@@ -26,6 +26,7 @@ from functools import lru_cache
 
 import coal
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
@@ -34,7 +35,7 @@ from ur3hanoi.hanoi import Move, stacks_before_moves
 from ur3hanoi.plan.collision import MAX_REPORTED, CollisionScene, clearance_rules, resting_blocks
 from ur3hanoi.plan.types import KinematicLimits, Phase, PlanConfig, Segment
 from ur3hanoi.plan.waypoints import geometry_key
-from ur3hanoi.robot import N_JOINTS
+from ur3hanoi.robot import DH_A, DH_ALPHA, DH_D, N_JOINTS, T_BASELINK_BASE, dh_link
 from ur3hanoi.station import Station
 
 Slot = tuple[int, int]
@@ -51,6 +52,14 @@ class Result:
     distance_m: float
     t_s: float
     geometry: int
+
+
+@dataclass
+class _Status:
+    """Per target of one (mover, requirement) on one segment: result known yet, and clear."""
+
+    known: npt.NDArray[np.bool_]
+    ok: npt.NDArray[np.bool_]
 
 
 class _Scene:
@@ -87,22 +96,42 @@ class _Scene:
         self.box_R = np.array([R_block] * len(self.slots) + [T.rotation])
         self.box_h = np.array([[s / 2] * 3] * len(self.slots) + [[2.0, 2.0, 0.05]])
         self.block_placement = [T * pin.SE3(self.cs._R_block, block_center_world(station, *sl)) for sl in self.slots]
+        # Each joint's placement relative to its DH frame (both are fixed to the same link): constant.
+        q0 = np.zeros(N_JOINTS)
+        pin.forwardKinematics(self.model, self.data, q0)
+        T = T_BASELINK_BASE.homogeneous
+        self.dh_to_joint = []
+        for i in range(N_JOINTS):
+            T = T @ dh_link(0.0, i)
+            self.dh_to_joint.append(np.linalg.inv(T) @ self.data.oMi[i + 1].homogeneous)
         self.gd = pin.GeometryData(gm)
         for req in self.gd.distanceRequests:  # explicit: never warm-start GJK from a previous query
             req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
 
+    def joint_frames(self, q: FloatArray) -> FloatArray:
+        """(S, njoints, 4, 4) placements of the model's joints in base_link at the configurations ``q`` (S, 6): the
+        DH chain (batched) times each joint's constant offset from its DH frame, i.e. Pinocchio's ``oMi``."""
+        S = len(q)
+        out = np.empty((S, self.model.njoints, 4, 4))
+        out[:, 0] = np.eye(4)
+        T = np.broadcast_to(T_BASELINK_BASE.homogeneous, (S, 4, 4))
+        for i in range(N_JOINTS):
+            ct, st = np.cos(q[:, i]), np.sin(q[:, i])
+            ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
+            A = np.zeros((S, 4, 4))
+            A[:, 0, 0], A[:, 0, 1], A[:, 0, 2], A[:, 0, 3] = ct, -st * ca, st * sa, DH_A[i] * ct
+            A[:, 1, 0], A[:, 1, 1], A[:, 1, 2], A[:, 1, 3] = st, ct * ca, -ct * sa, DH_A[i] * st
+            A[:, 2, 1], A[:, 2, 2], A[:, 2, 3] = sa, ca, DH_D[i]
+            A[:, 3, 3] = 1.0
+            T = T @ A
+            out[:, i + 1] = T @ self.dh_to_joint[i]
+        return out
+
     def sphere_bounds(self, q: FloatArray) -> FloatArray:
         """Lower bounds (S, G, targets) [m] of the distance from each geometry's bounding sphere to each target
         box, at the configurations ``q`` (S, 6)."""
-        S = len(q)
-        Rj = np.empty((S, self.model.njoints, 3, 3))
-        pj = np.empty((S, self.model.njoints, 3))
-        for k in range(S):
-            pin.forwardKinematics(self.model, self.data, q[k])
-            for j in range(self.model.njoints):
-                Rj[k, j] = self.data.oMi[j].rotation
-                pj[k, j] = self.data.oMi[j].translation
-        c = np.einsum("sgij,gj->sgi", Rj[:, self.parent], self.centers) + pj[:, self.parent]  # (S, G, 3)
+        F = self.joint_frames(q)[:, self.parent]  # (S, G, 4, 4)
+        c = np.einsum("sgij,gj->sgi", F[:, :, :3, :3], self.centers) + F[:, :, :3, 3]  # (S, G, 3)
         local = np.einsum("bji,sgbj->sgbi", self.box_R, c[:, :, None, :] - self.box_c[None, None])
         out = np.linalg.norm(np.maximum(np.abs(local) - self.box_h, 0.0), axis=-1)
         return out - self.radii[None, :, None]
@@ -137,6 +166,7 @@ class SegmentClearance:
     a_max: FloatArray
     step_s: float
     results: dict[tuple[str, int, float], Result] = field(default_factory=dict)
+    status: dict[tuple[str, float], _Status] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         n = max(1, math.ceil(self.duration / self.step_s - 1e-9))
@@ -147,11 +177,28 @@ class SegmentClearance:
         vb = np.maximum(np.abs(self.qd[:-1]), np.abs(self.qd[1:])) + self.a_max * dt[:, None] / 2
         self.deltas = (vb @ self.scene.cs.R) * dt / 2  # (S - 1,) [m]: displacement bound of each interval
 
-    def result(self, mover: str, target: int, required: float) -> Result:
-        key = (mover, target, required)
-        if key not in self.results:
-            self.results[key] = self._check(mover, target, required)
-        return self.results[key]
+    def _status(self, mover: str, required: float) -> _Status:
+        """Per target: proven clear by the bounds alone over the whole segment (one vectorised test)."""
+        key = (mover, required)
+        if key not in self.status:
+            cols = [self.scene.index[g] for g in self.scene.movers[mover]]
+            lbs = np.min(self.bounds[:, cols, :], axis=1)  # (S, targets)
+            need = max(required, STRICT_M)
+            if len(self.t) == 1:
+                proven = np.zeros(lbs.shape[1], dtype=bool)
+            else:
+                proven = np.all(np.minimum(lbs[:-1], lbs[1:]) - need >= self.deltas[:, None], axis=0)
+            self.status[key] = _Status(proven.copy(), proven.copy())
+        return self.status[key]
+
+    def failures(self, mover: str, required: float, targets: npt.NDArray[np.intp]) -> list[tuple[int, Result]]:
+        """(target, result) of each of ``targets`` (indices) the mover does not clear by ``required`` [m]."""
+        st = self._status(mover, required)
+        for k in targets[~st.known[targets]].tolist():
+            r = self._check(mover, k, required)
+            st.known[k], st.ok[k] = True, r.ok
+            self.results[(mover, k, required)] = r
+        return [(k, self.results[(mover, k, required)]) for k in targets[~st.ok[targets]].tolist()]
 
     def _check(self, mover: str, target: int, required: float) -> Result:
         sc = self.scene
@@ -261,24 +308,25 @@ def check_segments(segments: Sequence[Segment], moves: Sequence[Move], station: 
     stacks = stacks_before_moves(moves, n_blocks, start, station.n_towers)
     table = len(sc.slots)
     out: list[str] = []
-    rules_memo: dict[tuple[int, int], tuple[dict[int, Slot], list]] = {}
+    groups_memo: dict[tuple[int, int], list[tuple[str, float, npt.NDArray[np.intp], list[int | None]]]] = {}
     for seg in segments:
         mi, ph = seg.move_index, seg.phase
-        if (mi, int(ph)) not in rules_memo:
+        if (mi, int(ph)) not in groups_memo:
             slots = resting_blocks(stacks, moves, mi, ph)
-            m = moves[mi] if mi >= 0 else None
-            rules_memo[(mi, int(ph))] = (slots, clearance_rules(station, ph, m, slots, config.clearance_m))
-        slots, rules = rules_memo[(mi, int(ph))]
-        if not rules:
-            continue
+            grouped: dict[tuple[str, float], tuple[list[int], list[int | None]]] = {}
+            for r in clearance_rules(station, ph, moves[mi] if mi >= 0 else None, slots, config.clearance_m):
+                targets, blocks = grouped.setdefault((r.mover, r.required_m), ([], []))
+                targets.append(table if r.block is None else sc.slot_index[slots[r.block]])
+                blocks.append(r.block)
+            groups_memo[(mi, int(ph))] = [(mv, req, np.array(t, dtype=np.intp), b)
+                                          for (mv, req), (t, b) in grouped.items()]
         entry = cache.of(seg)
-        for r in rules:
-            target = table if r.block is None else sc.slot_index[slots[r.block]]
-            res = entry.result(r.mover, target, r.required_m)
-            if not res.ok:
-                other = "table" if r.block is None else f"block_{r.block}"
+        for mover, required, targets, blocks in groups_memo[(mi, int(ph))]:
+            for k, res in entry.failures(mover, required, targets):
+                block = blocks[targets.tolist().index(k)]
+                other = "table" if block is None else f"block_{block}"
                 out.append(f"{sc.cs.name(res.geometry)} is {res.distance_m * 1e3:.2f} mm from {other} (required "
-                           f"{r.required_m * 1e3:.1f} mm) at t = {seg.t_start + res.t_s:.3f} s ({Phase(ph).name}, "
+                           f"{required * 1e3:.1f} mm) at t = {seg.t_start + res.t_s:.3f} s ({Phase(ph).name}, "
                            f"move {mi + 1})")
                 if len(out) >= MAX_REPORTED:
                     return out

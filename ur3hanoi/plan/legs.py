@@ -134,6 +134,7 @@ class SlotLegs:
                                 self.accels.index(0.0) if 0.0 in self.accels else -1)
         self._lower: dict[Cell, tuple[float, RuckigTrajectory | None]] = {}
         self._legs: dict[Cell, tuple[Leg, Leg] | None] = {}
+        self._hard: bool | None = None
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -191,11 +192,21 @@ class SlotLegs:
         best = nelder_mead(cost, guess, step, max_evals=max_evals, f_target=lb * (1.0 + LOWER_BOUND_RTOL))
         return best.x, best.fun
 
+    @property
+    def hard(self) -> bool:
+        """True when one interior point cannot keep even the rest-to-rest leg on the line (it dips into the block
+        or leaves the line by more than twice the tolerance, e.g. near a singularity): the slot's other cells then
+        go straight to the many-point path-profile legs. A function of the slot alone."""
+        if self._hard is None:
+            lb, traj = self._lower_bound(self.rest_cell)
+            self._hard = traj is None or self._through_points(self.rest_cell, lb, traj, INTERIOR_FRACTIONS[0])[1]
+        return self._hard
+
     def _build(self, cell: Cell) -> tuple[Leg, Leg] | None:
         lb, traj = self._lower_bound(cell)
         if traj is None:
             return self._exact_path_legs() if cell == self.rest_cell else None
-        for fractions in INTERIOR_FRACTIONS:
+        for fractions in INTERIOR_FRACTIONS if not self.hard else ():
             legs, hopeless = self._through_points(cell, lb, traj, fractions)
             if legs is not None:
                 return legs
