@@ -18,6 +18,7 @@ Run: ``.venv/bin/python bench/bench_plan.py``. Reports, in one run:
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 import statistics
 import subprocess
@@ -85,7 +86,7 @@ def reference_leg_times(plan, exact_vertical: bool) -> tuple[float, float]:  # t
     vert = across = 0.0
     for hop in plan_hops(plan.station, plan.moves, plan.n_blocks, plan.start, cfg.clearance_m):
         qs = [planner.q_above(hop.slot0), planner.q_above(hop.slot1)]
-        across += sum(planner.rest_to_rest(a, b) for a, b in zip(qs, qs[1:], strict=False))
+        across += sum(planner.rest_to_rest(a, b) for a, b in itertools.pairwise(qs))
         for slot in (hop.slot0, hop.slot1):
             if slot is not None:
                 vert += (planner.exact_vertical_leg(slot) if exact_vertical

@@ -3,6 +3,8 @@ the plan's waypoints; the exact-vertical one is slower; the plan beats both."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -27,7 +29,7 @@ def test_honest_baseline_is_rest_to_rest_between_the_waypoints(shipped_station: 
     seq.append(wp.q_home)
     z = np.zeros(6)
     motion = 0.0
-    for a, b in zip(seq, seq[1:], strict=False):
+    for a, b in itertools.pairwise(seq):
         traj = rk.solve(a, z, z, b, z, z).trajectory
         assert traj is not None
         motion += traj.duration

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import json
 
 import numpy as np
@@ -56,7 +57,7 @@ def test_json_move_times(plan: Plan) -> None:
     times = plan.to_json_dict()["move_times"]
     assert [m["move"] for m in times] == [1, 2, 3, 0]
     assert times[0]["start_s"] == 0.0 and times[-1]["end_s"] == pytest.approx(plan.duration_s)
-    for a, b in zip(times, times[1:], strict=False):
+    for a, b in itertools.pairwise(times):
         assert a["end_s"] == pytest.approx(b["start_s"])
     for i, m in enumerate(plan.moves):
         d = m.as_lab_dict()

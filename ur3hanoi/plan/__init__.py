@@ -20,15 +20,19 @@ Module map (dependencies flow downward only):
 - :mod:`~ur3hanoi.plan.legs`: approach/retreat legs: joint-space Ruckig through interior IK points of the vertical
   line, verified by forward kinematics at 1 kHz; the method and why it was chosen are described there.
 - :mod:`~ur3hanoi.plan.via`: the search for a connection's via states at the two above poses.
+- :mod:`~ur3hanoi.plan.blend`: blending at the above poses: the motion across starts inside the 2 mm corridor.
 - :mod:`~ur3hanoi.plan.connections`: :class:`~ur3hanoi.plan.connections.Connection` (exit leg, motion across,
   entry leg) and the per-station cache :func:`~ur3hanoi.plan.connections.station_planner`.
 - :mod:`~ur3hanoi.plan.builder`: the hops of a move sequence (rising over taller towers) and the chained segments
   (pass-through or stop-and-go); how the motion is built is described there.
 - :mod:`~ur3hanoi.plan.baseline`: the honest stop-and-go baseline and the exact-vertical stop-and-go reference.
-- :mod:`~ur3hanoi.plan.collision`: :class:`CollisionScene` and :func:`check_collisions` (clearances).
+- :mod:`~ur3hanoi.plan.collision`: :class:`CollisionScene`, the clearance rules and :func:`check_collisions`
+  (clearances of any sampled trajectory).
+- :mod:`~ur3hanoi.plan.clearance`: the clearance check the planner runs, once per distinct segment (continuous
+  time, resolved to 1 ms).
 - :mod:`~ur3hanoi.plan.export`: :func:`trajectory_csv` and the JSON summary behind :meth:`Plan.to_json_dict`
   (what ``ur3hanoi plan`` prints).
-- :mod:`~ur3hanoi.plan.planner`: :func:`plan_moves` / :func:`plan_solve`: waypoints -> segments -> samples ->
+- :mod:`~ur3hanoi.plan.planner`: :func:`plan_moves` / :func:`plan_solve`: hops -> connections -> samples ->
   checks -> :class:`Plan`.
 
 CONTRACT (shared with ur3hanoi.sim; keep these names and meanings):
@@ -44,7 +48,8 @@ Limits: velocity from the UR3 datasheet (``JointLimits.ur3().v_max``: pi rad/s j
 acceleration 4/8 rad/s^2 and jerk 20/40 rad/s^3 (joints 1-3 / 4-6) are ``JointLimits`` defaults (UR does not
 publish them). ``PlanConfig.speed`` scales all three; each can be overridden. Every sample is checked against
 them, every sample of a vertical phase against the vertical line (``PlanConfig.vertical_tol_m``, 2 mm; every leg
-also by forward kinematics at 1 kHz where it is built), and the clearances by :func:`check_collisions`.
+also by forward kinematics at 1 kHz where it is built), and the clearances by the planner's segment check
+(:mod:`ur3hanoi.plan.clearance`; :func:`check_collisions` checks any sampled trajectory by the same rules).
 
 Speed (see ``bench/REPORT.md``): the motion is measured against the honest stop-and-go baseline (joint-space
 Ruckig from rest to rest between the same waypoints, same limits and dwells: ``Plan.stop_and_go_duration_s``);

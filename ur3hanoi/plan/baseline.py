@@ -14,6 +14,7 @@ Both are motion times [s] (dwells excluded).
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 
 from ur3hanoi.arrays import FloatArray
@@ -37,7 +38,7 @@ def _motion_s(planner: StationPlanner, hops: Sequence[Hop], exact_vertical: bool
     total = 0.0
     for hop in hops:
         qs = _waypoints(planner, hop)
-        total += sum(planner.rest_to_rest(a, b) for a, b in zip(qs, qs[1:], strict=False))
+        total += sum(planner.rest_to_rest(a, b) for a, b in itertools.pairwise(qs))
         for slot in (hop.slot0, hop.slot1):
             if slot is None:
                 continue

@@ -33,6 +33,7 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.grid import block_center_world, table_z
 from ur3hanoi.hanoi import Move, stacks_before_moves
 from ur3hanoi.plan.collision import MAX_REPORTED, CollisionScene, clearance_rules, resting_blocks
+from ur3hanoi.plan.sampling import evaluate
 from ur3hanoi.plan.types import KinematicLimits, Phase, PlanConfig, Segment
 from ur3hanoi.plan.waypoints import geometry_key
 from ur3hanoi.robot import DH_A, DH_ALPHA, DH_D, N_JOINTS, T_BASELINK_BASE, dh_link
@@ -274,8 +275,6 @@ class ClearanceCache:
 
 def _motion(seg: Segment) -> Callable[[FloatArray], tuple[FloatArray, FloatArray]]:
     """(q, qd) of a segment at local times: the Ruckig trajectory (through the path for an exact vertical leg)."""
-    from ur3hanoi.plan.sampling import evaluate
-
     traj = seg.trajectory
     if traj is None:
         q0 = seg.q_start
@@ -321,9 +320,9 @@ def check_segments(segments: Sequence[Segment], moves: Sequence[Move], station: 
             groups_memo[(mi, int(ph))] = [(mv, req, np.array(t, dtype=np.intp), b)
                                           for (mv, req), (t, b) in grouped.items()]
         entry = cache.of(seg)
-        for mover, required, targets, blocks in groups_memo[(mi, int(ph))]:
-            for k, res in entry.failures(mover, required, targets):
-                block = blocks[targets.tolist().index(k)]
+        for mover, required, target_ix, blocks in groups_memo[(mi, int(ph))]:
+            for k, res in entry.failures(mover, required, target_ix):
+                block = blocks[target_ix.tolist().index(k)]
                 other = "table" if block is None else f"block_{block}"
                 out.append(f"{sc.cs.name(res.geometry)} is {res.distance_m * 1e3:.2f} mm from {other} (required "
                            f"{required * 1e3:.1f} mm) at t = {seg.t_start + res.t_s:.3f} s ({Phase(ph).name}, "

@@ -15,6 +15,7 @@ stale entry, and the results do not depend on what was planned before.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -217,8 +218,8 @@ class StationPlanner:
                 exit_leg, states, chain = blender.side(legs0, exit_leg, states, chain, self._lateral(slot0, d), True)
                 entry_leg, states, chain = blender.side(legs1, entry_leg, states, chain, self._lateral(slot1, d),
                                                         False)
-        return Connection(exit_leg, tuple(states), tuple(chain), entry_leg,
-                          ((ix[0], ix[1]) if legs0 is not None else None, (ix[2], ix[3]) if legs1 is not None else None))
+        cells = ((ix[0], ix[1]) if legs0 is not None else None, (ix[2], ix[3]) if legs1 is not None else None)
+        return Connection(exit_leg, tuple(states), tuple(chain), entry_leg, cells)
 
     def _lateral(self, slot: Slot, d_world: FloatArray) -> FloatArray:
         """Joint velocity [rad/s] moving the suction point at the slot's above pose horizontally at 1 m/s along
@@ -241,7 +242,7 @@ class StationPlanner:
 
     def _chain(self, states: list[State]) -> list[RuckigTrajectory] | None:
         out = []
-        for s0, s1 in zip(states, states[1:], strict=False):
+        for s0, s1 in itertools.pairwise(states):
             traj = self.ruckig.solve(*s0, *s1).trajectory
             if traj is None:
                 return None

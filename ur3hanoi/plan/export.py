@@ -7,7 +7,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-
 from ur3hanoi.plan.types import Phase
 
 if TYPE_CHECKING:

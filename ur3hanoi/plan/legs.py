@@ -1,4 +1,4 @@
-"""Approach and retreat legs: joint-space Ruckig through an interior IK point of a slot's vertical line.
+"""Approach and retreat legs: joint-space Ruckig through interior IK points of a slot's vertical line.
 
 A leg joins a slot's "above" pose, where the robot passes at a via state, and its contact ("on") pose, at rest.
 The via state at the above pose moves the suction point along the vertical line: speed ``sigma`` [m/s] and path
@@ -12,25 +12,34 @@ Method, and why (measured on lab_sim/lab_real, see ``bench/REPORT.md``):
 - One joint-space Ruckig segment from above to on leaves the vertical line by 3-10 mm: the straight joint
   interpolation does not follow the curved ``q(s)``. Through ONE interior IK point on the line at 65 % of the
   approach, with its path speed and acceleration (2 numbers) chosen by :func:`~ur3hanoi.plan.optimize.nelder_mead`,
-  the leg stays within 0.5-1.6 mm of the line and takes the time of the single joint-space segment (within 0.1 %
-  on most slots): that segment is a lower bound (any chain through a via point is also a motion between the same
-  two states), so the search stops as soon as it reaches it. If one point is not enough for the corridor, two
-  (at 1/3 and 2/3) are tried.
-- The alternative of following the line exactly (a 1-DoF Ruckig of the path coordinate, limits constant over the
-  path from the worst derivatives) is 1.37-1.66x slower per leg: the joint derivatives vary ~10x along the
-  path, so one constant limit is a structural ceiling. It is kept as the always-feasible fallback of the
-  rest-to-rest leg and as the ``exact vertical`` reference (:mod:`ur3hanoi.plan.baseline`).
+  the leg stays within about 1-1.5 mm of the line and takes the time of the single joint-space segment (within
+  0.1 % on most cells): that segment is a lower bound (any chain through a via point is also a motion between the
+  same two states), so the search stops as soon as it comes within :data:`LOWER_BOUND_RTOL` of it. If one point
+  is not enough for the corridor, two (at 1/3 and 2/3) are tried.
+- Following the line exactly (a 1-DoF Ruckig of the path coordinate with limits constant over the path, from the
+  worst derivatives) is 1.4-1.6x slower per leg: the joint derivatives vary ~10x along the path, so one constant
+  limit is a structural ceiling. TOPP-RA (velocity and acceleration only) followed by a jerk-limited pass was the
+  other candidate; the interior-point legs already reach the joint-space time, so no new dependency was needed.
+- Near a singularity (a slot close to the base) the joint path curves so much at the contact end that one or two
+  points dip into the block: such slots (:attr:`SlotLegs.hard`) use many points (:data:`PROFILE_POINTS`, spaced
+  toward the contact) whose states come from the exact path timing; each segment is then at least as fast as that
+  timing between its points, and the leg keeps the line. The exact path-following leg remains the last resort of
+  the rest-to-rest cell, which therefore always has legs.
 - Every leg is verified where it is built, once per (slot, via cell, direction): the suction point by forward
   kinematics every millisecond (:data:`DENSE_RATE_HZ`), within ``tol_m`` of the line (less
   :data:`DENSE_MARGIN_M` for the samples in between) and never more than :data:`CONTACT_OVERSHOOT_M` below the
-  contact pose. Legs are shared by every connection that uses the cell, so a plan checks each distinct leg once.
+  contact pose (Ruckig's time-synchronised joints can settle a fraction of a millimetre past it; a suction cup
+  compresses by millimetres: lab_real's contact is 3 mm into the cup). Legs are shared by every connection that
+  uses the cell, so a plan checks each distinct leg once.
 
 Descend and lift are time reverses of each other (same duration by the symmetry of the limits); each is solved
-and verified on its own.
+and verified on its own. Every result is a pure function of (slot, cell): the cells of a slot can be built in any
+order.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -58,7 +67,7 @@ DENSE_RATE_HZ = 1000.0  # [Hz] rate of the forward-kinematics check of every leg
 # at most its lateral speed (< 0.05 m/s on a leg) times 0.5 ms, i.e. 25 um.
 DENSE_MARGIN_M = 5e-5
 CONTACT_OVERSHOOT_M = 5e-4  # [m] a leg may dip this far below the contact pose (see the module docstring)
-INTERIOR_FRACTIONS: tuple[tuple[float, ...], ...] = ((0.65,), (1 / 3, 2 / 3))  # tried in order, of the approach
+INTERIOR_FRACTIONS: tuple[tuple[float, ...], ...] = ((0.65,), (1 / 3, 2 / 3), (0.25, 0.5, 0.75))  # in order
 LOWER_BOUND_RTOL = 1e-3  # the interior search stops within this of the single-segment lower bound
 # Start of the one-point search, in units (vb, vb / T0): the optima of the lab stations' legs lie at 1.7-1.95 vb
 # and -2.6 to -4.5 vb / T0 over the whole via grid.
@@ -92,10 +101,14 @@ class Leg:
 
 
 def within_limits(state: State, limits: KinematicLimits) -> bool:
-    """True when a via state's velocity and acceleration are within the limits (Ruckig rejects a target outside
-    them, and a start outside them would brake beyond them)."""
+    """True when a via state is within the limits in Ruckig's sense: acceleration within ``a_max``, and velocity
+    within ``v_max`` even after the acceleration is brought to zero at full jerk (``v + a |a| / (2 j)``).
+    Otherwise Ruckig rejects it as a target, or starts from it with a brake profile that overshoots the velocity
+    limit."""
     _, v, a = state
-    return bool((np.abs(v) <= limits.v_max).all() and (np.abs(a) <= limits.a_max).all())
+    if not (np.abs(a) <= limits.a_max).all():
+        return False
+    return bool((np.abs(v + a * np.abs(a) / (2.0 * limits.j_max)) <= limits.v_max).all())
 
 
 class SlotLegs:
@@ -127,7 +140,11 @@ class SlotLegs:
         if rest.trajectory is None:
             raise PlanError(f"Ruckig failed on the rest-to-rest leg of slot {slot}: {rest.reason}")
         self.t_rest = rest.trajectory.duration  # T0 [s]
-        self.vb = self.path.length_m / self.t_rest  # [m/s]
+        # The grid unit: the rest-to-rest leg's mean speed, but at most a third of the largest via speed the joint
+        # velocity limits allow at the above pose (slow limits make a leg velocity-bound, not jerk-bound).
+        dq0 = np.abs(self.path.dq[0])
+        sigma_max = float(np.min(limits.v_max[dq0 > 1e-9] / dq0[dq0 > 1e-9])) if np.any(dq0 > 1e-9) else math.inf
+        self.vb = min(self.path.length_m / self.t_rest, sigma_max / 3.0)  # [m/s]
         self.speeds = tuple(float(f) * self.vb for f in speeds)  # sigma [m/s]
         self.accels = tuple(float(f) * self.vb / self.t_rest for f in accels)  # [m/s^2]
         self.rest_cell: Cell = (self.speeds.index(0.0) if 0.0 in self.speeds else -1,
@@ -194,9 +211,9 @@ class SlotLegs:
 
     @property
     def hard(self) -> bool:
-        """True when one interior point cannot keep even the rest-to-rest leg on the line (it dips into the block
-        or leaves the line by more than twice the tolerance, e.g. near a singularity): the slot's other cells then
-        go straight to the many-point path-profile legs. A function of the slot alone."""
+        """True when one interior point makes even the rest-to-rest leg dip into the block (the joint path curves
+        sharply at the contact end, near a singularity): more points at the same places would too, so the slot's
+        other cells go straight to the many-point path-profile legs. A function of the slot alone."""
         if self._hard is None:
             lb, traj = self._lower_bound(self.rest_cell)
             self._hard = traj is None or self._through_points(self.rest_cell, lb, traj, INTERIOR_FRACTIONS[0])[1]
@@ -234,7 +251,7 @@ class SlotLegs:
 
     def _chain(self, states: Sequence[State]) -> list[RuckigTrajectory] | None:
         out = []
-        for s0, s1 in zip(states, states[1:], strict=False):
+        for s0, s1 in itertools.pairwise(states):
             traj = self.ruckig.solve(*s0, *s1).trajectory
             if traj is None:
                 return None
@@ -282,7 +299,7 @@ class SlotLegs:
             if dip > CONTACT_OVERSHOOT_M:
                 return None, True
             if dev > self.tol_m - DENSE_MARGIN_M:
-                return None, dev > 2.0 * self.tol_m
+                return None, False
             legs.append(Leg(tuple(states), tuple(chain), sum(t.duration for t in chain), dev))
         return (legs[0], legs[1]), False
 

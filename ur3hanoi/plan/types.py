@@ -5,6 +5,7 @@ All are frozen dataclasses (or an IntEnum); the modules of :mod:`ur3hanoi.plan` 
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from enum import IntEnum
@@ -110,8 +111,8 @@ class PlanConfig:
         vertical_tol_m: allowed distance [m] of the suction point from the vertical line in vertical phases.
         clearance_m: required clearance [m] of the carried block from every other block.
         check_collisions: run the Pinocchio/coal clearance checks (slower; limits are always checked).
-        collision_rate_hz: coarse rate [Hz] of the clearance check; refined to every sample where the margin is
-            not provably enough (see :class:`ur3hanoi.plan.collision.CollisionScene`).
+        collision_rate_hz: coarse rate [Hz] of the clearance check; refined down to 1 ms where the margin is not
+            provably enough (see :mod:`ur3hanoi.plan.clearance`).
         raise_on_violation: raise PlanError on the first violation list (False: return it in Plan.violations).
     """
 
@@ -147,7 +148,7 @@ class PlanConfig:
             grid = getattr(self, name)
             lo = 0.0 if name == "via_speeds" else -math.inf
             if (0.0 not in grid or not all(math.isfinite(x) and x >= lo for x in grid)
-                    or any(b <= a for a, b in zip(grid, grid[1:], strict=False))):
+                    or any(b <= a for a, b in itertools.pairwise(grid))):
                 raise PlanError(f"{name} = {grid!r} is invalid: expected increasing finite values including 0"
                                 + (", none negative" if name == "via_speeds" else ""))
         for name in ("collision_rate_hz", "vertical_tol_m", "clearance_m"):
