@@ -73,7 +73,7 @@ LOWER_BOUND_RTOL = 1e-3  # the interior search stops within this of the single-s
 # and -2.6 to -4.5 vb / T0 over the whole via grid.
 ONE_POINT_GUESS = (1.8, -3.0)
 SEARCH_STEP = (0.05, 0.5)  # initial simplex of the search, same units
-MAX_EVALS = 40  # cost evaluations of the search per interior point
+MAX_EVALS = 24  # cost evaluations of the search per interior point
 # Numbers of interior points of the path-profile legs (see _profile_legs), tried in order; they are spaced
 # quadratically toward the contact pose, where the joint path curves most (near the arm's singularities).
 PROFILE_POINTS = (4, 6, 8, 12)
@@ -275,8 +275,8 @@ class SlotLegs:
     def _through_points(self, cell: Cell, lb: float, traj: RuckigTrajectory, fractions: Sequence[float]
                         ) -> tuple[tuple[Leg, Leg] | None, bool]:
         """Legs through interior points at ``fractions`` of the approach; (None, hopeless) if they do not fit
-        (hopeless: they dip below the contact pose, or leave the line by more than twice the tolerance: more points
-        would not bring them back)."""
+        (hopeless: they dip below the contact pose, or, at a moving via cell, leave the line by more than twice the
+        tolerance: more points would not bring them back)."""
         if len(fractions) == 1:
             guess = [ONE_POINT_GUESS[0] * self.vb, ONE_POINT_GUESS[1] * self.vb / self.t_rest]
         else:
@@ -298,8 +298,8 @@ class SlotLegs:
             dev, dip = self.corridor(chain)
             if dip > CONTACT_OVERSHOOT_M:
                 return None, True
-            if dev > self.tol_m - DENSE_MARGIN_M:
-                return None, False
+            if dev > self.tol_m - DENSE_MARGIN_M:  # far off (not at rest): braking too late, more points won't help
+                return None, cell != self.rest_cell and dev > 2.0 * self.tol_m
             legs.append(Leg(tuple(states), tuple(chain), sum(t.duration for t in chain), dev))
         return (legs[0], legs[1]), False
 
