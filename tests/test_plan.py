@@ -19,6 +19,7 @@ from ur3hanoi.cli import main
 from ur3hanoi.errors import PlanError, PuzzleError
 from ur3hanoi.grid import ABOVE, ON
 from ur3hanoi.plan import Phase, Plan, PlanConfig, build_waypoints, check_collisions, check_vertical, plan_solve
+from ur3hanoi.plan.legs import DENSE_MARGIN_M
 from ur3hanoi.resources import stations_dir
 from ur3hanoi.station import Station, load_station
 
@@ -165,7 +166,9 @@ def test_limits_line_and_clearances_hold_at_1khz(stations: dict[str, Station]) -
         np.testing.assert_allclose(np.diff(plan.trajectory.t), 1e-3)
         _assert_limits(plan)
         viol, worst = check_vertical(plan.trajectory, plan.moves, st_, 0.002)
-        assert viol == [] and worst <= plan.vertical_deviation_m + 1e-9 <= 0.002 + 1e-9
+        # Other sample times than the legs' own 1 kHz check: within its margin of what it measured.
+        assert viol == [] and worst <= plan.vertical_deviation_m + DENSE_MARGIN_M
+        assert plan.vertical_deviation_m <= 0.002 - DENSE_MARGIN_M
         assert plan.limits is not None
         assert check_collisions(plan.trajectory, plan.moves, st_, plan.n_blocks, plan.start, plan.config,
                                 plan.limits) == []
