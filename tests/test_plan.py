@@ -208,3 +208,12 @@ def test_cli_json_and_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
 def test_config_rejects_non_finite_or_non_positive(field: str, value: float) -> None:
     with pytest.raises(PlanError, match=field):
         dataclasses.replace(PlanConfig(), **{field: value}).validate()
+
+
+@pytest.mark.parametrize(("field", "value"), [("via_speeds", (0.5, 1.0)), ("via_speeds", (0.0, -1.0)),
+                                              ("via_speeds", (0.0, 2.0, 1.0)), ("via_accels", (1.0, 2.0)),
+                                              ("via_accels", (0.0, float("nan")))])
+def test_config_rejects_a_bad_via_grid(field: str, value: tuple[float, ...]) -> None:
+    """The grid must hold 0 (the rest-to-rest fallback) and increase (the search steps to neighbours)."""
+    with pytest.raises(PlanError, match=field):
+        dataclasses.replace(PlanConfig(), **{field: value}).validate()

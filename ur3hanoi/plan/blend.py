@@ -9,8 +9,8 @@ entry side: the arm is ending its motion across). The exit side is blended first
 minimise the duration of the two segments they change (the top segment of the leg and the adjacent segment across:
 a small Nelder-Mead search, :func:`~ur3hanoi.plan.optimize.nelder_mead`), and are then scaled back (bisection)
 until the changed leg segment passes the same forward-kinematics check at 1 kHz as every leg
-(:meth:`~ur3hanoi.plan.legs.SlotLegs.corridor`). Measured gain: 1 % of the motion on lab_sim, 5 % on lab_real,
-where every move turns the base.
+(:meth:`~ur3hanoi.plan.legs.SlotLegs.corridor`). Measured gain (3 blocks): 1.1 % of the motion on lab_sim, 6 % on
+lab_real, where every move turns the base (worst distance from the line 1.0 -> 1.8 mm there).
 """
 
 from __future__ import annotations

@@ -4,7 +4,9 @@ A connection is everything between two grasp/release dwells (or home): the exit 
 (lift or retreat), the joint-space Ruckig motion across to the slot it enters (through "over" points when towers on
 the way are taller than the above poses), and that slot's entry leg (descend). Its via cells (the states at the two
 above poses) are chosen by :func:`~ur3hanoi.plan.via.best_cells` for the least summed duration; the legs come
-from :class:`~ur3hanoi.plan.legs.SlotLegs`.
+from :class:`~ur3hanoi.plan.legs.SlotLegs`; then :class:`~ur3hanoi.plan.blend.Blender` starts the motion across
+inside the corridor at both above poses. The over points are passed at rest (tall grids only: the lab's towers
+never need them).
 
 :func:`station_planner` returns the :class:`StationPlanner` of a station and its planning limits, built once and
 cached (least recently used, a few stations): its legs, connections and reference durations are memoized. Every

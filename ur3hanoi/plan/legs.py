@@ -12,7 +12,7 @@ Method, and why (measured on lab_sim/lab_real, see ``bench/REPORT.md``):
 - One joint-space Ruckig segment from above to on leaves the vertical line by 3-10 mm: the straight joint
   interpolation does not follow the curved ``q(s)``. Through ONE interior IK point on the line at 65 % of the
   approach, with its path speed and acceleration (2 numbers) chosen by :func:`~ur3hanoi.plan.optimize.nelder_mead`,
-  the leg stays within about 1-1.5 mm of the line and takes the time of the single joint-space segment (within
+  the leg stays within 0.5-1.6 mm of the line and takes the time of the single joint-space segment (within
   0.1 % on most cells): that segment is a lower bound (any chain through a via point is also a motion between the
   same two states), so the search stops as soon as it comes within :data:`LOWER_BOUND_RTOL` of it. If one point
   is not enough for the corridor, two (at 1/3 and 2/3) are tried.
