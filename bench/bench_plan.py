@@ -138,6 +138,7 @@ def scaling() -> None:
     print(f"{'N':>3} {'moves':>6} {'set-up s':>9} {'cold':>7} {'warm':>7} | cold: {'build':>6} {'sample':>7} "
           f"{'checks':>7} {'clear.':>7} | {'ratio':>6}")
     worst_cold = worst_warm = worst_setup = 0.0
+    fit: list[tuple[int, float, float]] = []
     for n in range(1, 11):
         out = subprocess.run([sys.executable, __file__, "--one", str(n)], capture_output=True, text=True, cwd=ROOT)
         if out.returncode != 0:
@@ -148,12 +149,24 @@ def scaling() -> None:
         t = d["timings"]
         worst_cold, worst_warm = max(worst_cold, d["cold"] / m), max(worst_warm, d["warm"] / m)
         worst_setup = max(worst_setup, d["setup"])
+        fit.append((m, d["cold"], d["warm"]))
         print(f"{n:>3} {m:>6} {d['setup']:>9.3f} {d['cold'] / m * 1e3:>7.2f} {d['warm'] / m * 1e3:>7.2f} | "
               f"{'':>5} {t['build'] / m * 1e3:>6.2f} {t['sampling'] / m * 1e3:>7.2f} {t['checks'] / m * 1e3:>7.2f} "
               f"{t.get('collision', 0.0) / m * 1e3:>7.2f} | {d['ratio']:>6.3f}"
               + (f"  {d['violations']} violations" if d["violations"] else ""))
     print(f"worst: set-up {worst_setup:.3f} s (target < 1 s), cold {worst_cold * 1e3:.2f} ms/move, warm "
           f"{worst_warm * 1e3:.2f} ms/move (target < 5 ms)")
+    if len(fit) >= 2:
+        # Least squares total = fixed + per_move * moves: the first plan's legs and connections are built once per
+        # station and reused by every later move (the fixed part); what each further move costs is the slope.
+        for name, col in (("cold", 1), ("warm", 2)):
+            moves = [f[0] for f in fit]
+            totals = [f[col] for f in fit]
+            mm, mt = statistics.fmean(moves), statistics.fmean(totals)
+            cov = sum((x - mm) * (y - mt) for x, y in zip(moves, totals, strict=True))
+            slope = cov / sum((x - mm) ** 2 for x in moves)
+            print(f"{name} planning time = {mt - slope * mm:.3f} s + {slope * 1e3:.2f} ms x moves (least squares, "
+                  "N = 1..10)")
 
 
 def main() -> None:
