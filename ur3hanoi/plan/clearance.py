@@ -307,18 +307,17 @@ def check_segments(segments: Sequence[Segment], moves: Sequence[Move], station: 
     stacks = stacks_before_moves(moves, n_blocks, start, station.n_towers)
     table = len(sc.slots)
     out: list[str] = []
-    groups_memo: dict[tuple[int, int], list[tuple[str, float, npt.NDArray[np.intp], list[int | None]]]] = {}
+    groups_memo: dict[tuple[int, int], list[tuple[str, float, npt.NDArray[np.intp], tuple[int | None, ...]]]] = {}
     for seg in segments:
         mi, ph = seg.move_index, seg.phase
         if (mi, int(ph)) not in groups_memo:
             slots = resting_blocks(stacks, moves, mi, ph)
-            grouped: dict[tuple[str, float], tuple[list[int], list[int | None]]] = {}
-            for r in clearance_rules(station, ph, moves[mi] if mi >= 0 else None, slots, config.clearance_m):
-                targets, blocks = grouped.setdefault((r.mover, r.required_m), ([], []))
-                targets.append(table if r.block is None else sc.slot_index[slots[r.block]])
-                blocks.append(r.block)
-            groups_memo[(mi, int(ph))] = [(mv, req, np.array(t, dtype=np.intp), b)
-                                          for (mv, req), (t, b) in grouped.items()]
+            index = {b: sc.slot_index[s] for b, s in slots.items()}
+            groups_memo[(mi, int(ph))] = [
+                (r.mover, r.required_m, np.array([table if b is None else index[b] for b in r.blocks], dtype=np.intp),
+                 r.blocks)
+                for r in clearance_rules(station, ph, moves[mi] if mi >= 0 else None, slots, config.clearance_m)
+                if r.blocks]
         entry = cache.of(seg)
         for mover, required, target_ix, blocks in groups_memo[(mi, int(ph))]:
             for k, res in entry.failures(mover, required, target_ix):

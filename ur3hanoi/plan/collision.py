@@ -178,11 +178,12 @@ def resting_blocks(stacks: Sequence[Sequence[Sequence[int]]], moves: Sequence[Mo
 
 @dataclass(frozen=True)
 class Rule:
-    """One required clearance: ``mover`` ("robot": every robot geometry but the base, "cup", or "carried") against
-    the resting block ``block`` (None: the table), at least ``required_m`` [m] (0: strictly positive)."""
+    """Required clearances of one ``mover`` ("robot": every robot geometry but the base, "cup", or "carried")
+    against each of ``blocks`` (resting blocks; None stands for the table), at least ``required_m`` [m] (0: strictly
+    positive)."""
 
     mover: str
-    block: int | None
+    blocks: tuple[int | None, ...]
     required_m: float
 
 
@@ -197,24 +198,22 @@ def clearance_rules(station: Station, ph: Phase, m: Move | None, slots: dict[int
     (>= ``clearance_m``), except the block it rests on at contact (stacked layout: the one under its source while
     lifting, under its destination while descending to place).
     """
-    rules = [Rule("robot", None, 0.0)]
-    if ph not in (*VERTICAL_PHASES, *DWELL_PHASES):
-        rules.append(Rule("cup", None, 0.0))
-    for b in slots:
-        rules.append(Rule("robot", b, 0.0))
-        if not (m is not None and b == m.block and ph in _CUP_ON_MOVED_BLOCK):
-            rules.append(Rule("cup", b, 0.0))
+    blocks = tuple(slots)
+    cup_on = m.block if m is not None and ph in _CUP_ON_MOVED_BLOCK else None
+    cup_table: tuple[int | None, ...] = () if ph in (*VERTICAL_PHASES, *DWELL_PHASES) else (None,)
+    rules = [Rule("robot", (None, *blocks), 0.0),
+             Rule("cup", (*cup_table, *(b for b in blocks if b != cup_on)), 0.0)]
     if m is None or not ph.carrying:
         return rules
-    if ph == Phase.CARRY:
-        rules.append(Rule("carried", None, 0.0))
     under = None
     if station.layout == "stacked":
         if ph == Phase.LIFT and m.from_height > 0:
             under = (m.from_tower, m.from_height - 1)
         if ph == Phase.DESCEND_PLACE and m.to_height > 0:
             under = (m.to_tower, m.to_height - 1)
-    rules += [Rule("carried", b, clearance_m) for b, slot in slots.items() if slot != under]
+    if ph == Phase.CARRY:
+        rules.append(Rule("carried", (None,), 0.0))
+    rules.append(Rule("carried", tuple(b for b, slot in slots.items() if slot != under), clearance_m))
     return rules
 
 
@@ -222,9 +221,10 @@ def _pairs(scene: CollisionScene, rules: Sequence[Rule]) -> list[Pair]:
     """The scene's geometry pairs of ``rules`` (a robot rule expands to every robot geometry but the base)."""
     pairs: list[Pair] = []
     for r in rules:
-        target = scene.table if r.block is None else scene.blocks[r.block]
-        for g in scene.movers(r.mover):
-            pairs.append(((g, target), r.required_m))
+        for b in r.blocks:
+            target = scene.table if b is None else scene.blocks[b]
+            for g in scene.movers(r.mover):
+                pairs.append(((g, target), r.required_m))
     return pairs
 
 

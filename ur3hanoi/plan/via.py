@@ -20,6 +20,8 @@ from collections.abc import Callable, Sequence
 
 Cell = tuple[int, int]
 Pair = tuple[int, int, int, int]  # exit cell, entry cell
+# Descents per search: each one after the first follows a leg found infeasible; the lab's connections take at most 4.
+MAX_DESCENTS = 8
 
 
 def _descend(cur: Pair, dims: Sequence[int], cost: Callable[[Pair], float]) -> Pair:
@@ -46,8 +48,9 @@ def best_cells(dims: Pair, start: Pair, bounds: tuple[Callable[[Cell], float], C
 
     ``dims``: grid sizes (exit speeds, exit accelerations, entry speeds, entry accelerations). ``bounds[k](c) <=
     exacts[k](c)`` for the exit (k = 0) and entry (k = 1) legs; inf marks an infeasible leg or motion across. If the
-    descent ends on an infeasible candidate, it restarts from the least-cost candidate seen; if nothing feasible
-    is left, the result is ``fallback``, which the caller guarantees to be feasible (the rest-to-rest legs).
+    descent ends on an infeasible candidate, it restarts from the least-cost candidate seen; after
+    :data:`MAX_DESCENTS` descents it takes the best candidate whose legs it built. If nothing feasible is left, the
+    result is ``fallback``, which the caller guarantees to be feasible (the rest-to-rest legs).
     """
     known: tuple[dict[Cell, float], dict[Cell, float]] = ({}, {})
     seen: set[Pair] = set()
@@ -61,7 +64,7 @@ def best_cells(dims: Pair, start: Pair, bounds: tuple[Callable[[Cell], float], C
         return legs + across(p) if math.isfinite(legs) else math.inf
 
     cur = start
-    while True:
+    for _ in range(MAX_DESCENTS):
         cur = _descend(cur, dims, cost)
         c0, c1 = (cur[0], cur[1]), (cur[2], cur[3])
         if c0 not in known[0]:
@@ -78,3 +81,7 @@ def best_cells(dims: Pair, start: Pair, bounds: tuple[Callable[[Cell], float], C
         if not finite:
             return fallback
         cur = finite[0][1]
+    # Out of descents (many infeasible legs around): the best candidate whose legs are both built, else the fallback.
+    built = sorted((cost(p), p) for p in sorted(seen)
+                   if (p[0], p[1]) in known[0] and (p[2], p[3]) in known[1] and math.isfinite(cost(p)))
+    return built[0][1] if built else fallback
