@@ -233,10 +233,18 @@ class StationPlanner:
 
     @staticmethod
     def _start(legs: SlotLegs) -> Cell:
+        """The search start: the cell nearest :data:`SEARCH_START` (grid steps) whose lower bound is finite (the
+        rest cell if none)."""
         def nearest(values: tuple[float, ...], target: float) -> int:
             return min(range(len(values)), key=lambda i: abs(values[i] - target))
-        return (nearest(legs.speeds, SEARCH_START[0] * legs.vb),
-                nearest(legs.accels, SEARCH_START[1] * legs.vb / legs.t_rest))
+        i0 = nearest(legs.speeds, SEARCH_START[0] * legs.vb)
+        j0 = nearest(legs.accels, SEARCH_START[1] * legs.vb / legs.t_rest)
+        n_i, n_j = legs.shape
+        by_distance = sorted((abs(i - i0) + abs(j - j0), i, j) for i in range(n_i) for j in range(n_j))
+        for _, i, j in by_distance:
+            if math.isfinite(legs.lower_bound((i, j))):
+                return i, j
+        return legs.rest_cell
 
     @staticmethod
     def _name(slot: Slot | None) -> str:

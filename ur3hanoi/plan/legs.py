@@ -173,6 +173,10 @@ class SlotLegs:
         return self._lower_bound(cell)[0]
 
     def _lower_bound(self, cell: Cell) -> tuple[float, RuckigTrajectory | None]:
+        if cell not in self._lower and cell != self.rest_cell and self.hard:
+            pl = self._path_limits()  # a hard slot's legs follow the path timing, which must admit the via state
+            if self.speeds[cell[0]] > pl.v or abs(self.accels[cell[1]]) > pl.a:
+                self._lower[cell] = (math.inf, None)
         if cell not in self._lower:
             a = self.above_state(cell, down=True)
             traj = self.ruckig.solve(*a, *self.on).trajectory if within_limits(a, self.limits) else None
