@@ -18,7 +18,8 @@ from hypothesis import strategies as st
 from ur3hanoi.cli import main
 from ur3hanoi.errors import PlanError, PuzzleError
 from ur3hanoi.grid import ABOVE, ON
-from ur3hanoi.plan import Phase, Plan, PlanConfig, build_waypoints, check_vertical, plan_solve
+from ur3hanoi.plan import Phase, Plan, PlanConfig, build_waypoints, check_collisions, check_vertical, plan_solve
+from ur3hanoi.plan.legs import DENSE_MARGIN_M
 from ur3hanoi.resources import stations_dir
 from ur3hanoi.station import Station, load_station
 
@@ -94,14 +95,16 @@ def test_dwell_samples_rest_on_contact(plans: dict[tuple[str, int, int, int], Pl
     assert not np.any(tr.suction[tr.phase == int(Phase.TRANSIT)])
 
 
-def test_pass_through_beats_stop_and_go(plans: dict[tuple[str, int, int, int], Plan]) -> None:
+def test_faster_than_the_honest_baseline(plans: dict[tuple[str, int, int, int], Plan]) -> None:
+    """Every plan beats joint-space stop-and-go between the same waypoints; the 3-block lab cycles by at least
+    15 % (the issue's bound: motion at most 0.85 x the baseline)."""
     for plan in plans.values():
-        assert plan.duration_s <= plan.stop_and_go_duration_s + 1e-9
-    lab = plans[("lab_sim", 0, 2, 3)]
-    assert lab.motion_saving >= 0.15
+        assert plan.motion_s < plan.stop_and_go_motion_s
+    for name in STATIONS:
+        assert plans[(name, 0, 2, 3)].motion_s <= 0.85 * plans[(name, 0, 2, 3)].stop_and_go_motion_s
     # No stop at a pass-through above point: the via velocity into each descend is non-zero.
-    descends = [s for s in lab.segments if s.phase == Phase.DESCEND_PICK]
-    assert any(np.linalg.norm(s.v_start) > 0.1 for s in descends)
+    descends = [s for s in plans[("lab_sim", 0, 2, 3)].segments if s.phase == Phase.DESCEND_PICK]
+    assert all(np.linalg.norm(s.v_start) > 0.1 for s in descends if s.target.startswith("via"))
 
 
 def test_vertical_approach_within_2mm(plans: dict[tuple[str, int, int, int], Plan]) -> None:
@@ -110,10 +113,17 @@ def test_vertical_approach_within_2mm(plans: dict[tuple[str, int, int, int], Pla
         assert viol == [] and worst < 0.002
 
 
-def test_tall_grid_all_heights(stations: dict[str, Station]) -> None:
-    tall = dataclasses.replace(stations["lab_real"], n_heights=5)
-    plan = plan_solve(tall, 0, 2, 5, PlanConfig(check_collisions=False))
-    assert len(plan.moves) == 31 and plan.violations == ()
+def test_tall_grid_plans_every_n(stations: dict[str, Station]) -> None:
+    """A 10-level grid (towers pulled in so the top levels are reachable) plans 1..10 blocks with every check,
+    clearances included: the carried block rises over taller towers (it hit block_6 from 8 blocks up before)."""
+    real = stations["lab_real"]
+    tall = dataclasses.replace(real, n_heights=10, tower_origins=tuple((0.22, y, z) for _, y, z in real.tower_origins))
+    for n in range(1, 11):
+        plan = plan_solve(tall, 0, 2, n)
+        assert len(plan.moves) == 2**n - 1 and plan.violations == ()
+        assert plan.motion_s <= plan.stop_and_go_motion_s
+        if n >= 8:
+            assert any(s.target.startswith("over") for s in plan.segments)
 
 
 def test_puzzle_errors(stations: dict[str, Station]) -> None:
@@ -131,16 +141,37 @@ def test_rate_500(stations: dict[str, Station]) -> None:
     _assert_limits(plan)
 
 
-@settings(max_examples=6, deadline=None)
-@given(speed=st.floats(0.2, 1.0), shift=st.tuples(st.floats(-0.03, 0.03), st.floats(-0.03, 0.03)),
+@settings(max_examples=6, deadline=None, derandomize=True)
+@given(name=st.sampled_from(sorted(STATIONS)), speed=st.floats(0.2, 1.0),
+       shift=st.tuples(st.floats(-0.04, 0.04), st.floats(-0.04, 0.04)), yaw=st.floats(-0.3, 0.3),
        pair=st.sampled_from(PAIRS))
-def test_limits_property(speed: float, shift: tuple[float, float], pair: tuple[int, int]) -> None:
-    base = load_station(STATIONS["lab_real"])
+def test_never_slower_than_the_honest_baseline(name: str, speed: float, shift: tuple[float, float], yaw: float,
+                                               pair: tuple[int, int]) -> None:
+    """Random stations (the lab grids moved and turned) and speeds: within the limits, on the vertical line, and
+    never slower than joint-space stop-and-go between the same waypoints."""
+    base = load_station(STATIONS[name])
     moved = base.with_grid([(x + shift[0], y + shift[1], z) for x, y, z in base.tower_origins], base.height_step,
-                           base.tool_yaw)
+                           base.tool_yaw + yaw)
     plan = plan_solve(moved, pair[0], pair[1], 2, PlanConfig(speed=speed, check_collisions=False))
     _assert_limits(plan)
-    assert plan.duration_s <= plan.stop_and_go_duration_s + 1e-9
+    assert plan.vertical_deviation_m <= 0.002
+    assert plan.motion_s <= plan.stop_and_go_motion_s
+
+
+def test_limits_line_and_clearances_hold_at_1khz(stations: dict[str, Station]) -> None:
+    """Sampled at 1 kHz: every sample within the limits and within 2 mm of the vertical line, and the clearances
+    (the segment check resolves to 1 ms; the sample-based check agrees at 1 kHz)."""
+    for st_ in stations.values():
+        plan = plan_solve(st_, 0, 2, 3, PlanConfig(rate_hz=1000.0))
+        np.testing.assert_allclose(np.diff(plan.trajectory.t), 1e-3)
+        _assert_limits(plan)
+        viol, worst = check_vertical(plan.trajectory, plan.moves, st_, 0.002)
+        # Other sample times than the legs' own 1 kHz check: within its margin of what it measured.
+        assert viol == [] and worst <= plan.vertical_deviation_m + DENSE_MARGIN_M
+        assert plan.vertical_deviation_m <= 0.002 - DENSE_MARGIN_M
+        assert plan.limits is not None
+        assert check_collisions(plan.trajectory, plan.moves, st_, plan.n_blocks, plan.start, plan.config,
+                                plan.limits) == []
 
 
 # ----------------------------------------------------------------------------------------------------------- CLI
@@ -159,20 +190,30 @@ def test_cli_json_and_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
                "--csv", str(out), "--json"])
     assert rc == 0
     data = json.loads(capsys.readouterr().out)
-    for key in ("moves", "duration_s", "stop_and_go_duration_s", "rate_hz", "max_abs_velocity",
-                "max_abs_acceleration", "max_abs_jerk", "velocity_limit", "acceleration_limit", "jerk_limit",
-                "violations"):
+    for key in ("moves", "duration_s", "stop_and_go_duration_s", "exact_vertical_stop_and_go_duration_s", "rate_hz",
+                "max_abs_velocity", "max_abs_acceleration", "max_abs_jerk", "velocity_limit", "acceleration_limit",
+                "jerk_limit", "violations", "move_times"):
         assert key in data
     assert data["moves"][0] == {"block": 2, "from_tower": 1, "from_height": 2, "to_tower": 2, "to_height": 1}
     assert data["violations"] == [] and len(data["max_abs_jerk"]) == 6
     with out.open() as f:
         rows = list(csv.reader(f))
-    assert rows[0] == ["t", *(f"q{i}" for i in range(1, 7)), *(f"qd{i}" for i in range(1, 7)), "suction"]
-    assert {r[-1] for r in rows[1:]} == {"0", "1"}
+    assert rows[0] == ["t", *(f"q{i}" for i in range(1, 7)), *(f"qd{i}" for i in range(1, 7)), "suction", "move",
+                       "phase"]
+    assert {r[13] for r in rows[1:]} == {"0", "1"} and {r[14] for r in rows[1:]} == {"0", "1", "2", "3"}
 
 
 @pytest.mark.parametrize("field", ["collision_rate_hz", "vertical_tol_m", "clearance_m"])
 @pytest.mark.parametrize("value", [float("nan"), 0.0, -1.0, float("inf")])
 def test_config_rejects_non_finite_or_non_positive(field: str, value: float) -> None:
+    with pytest.raises(PlanError, match=field):
+        dataclasses.replace(PlanConfig(), **{field: value}).validate()
+
+
+@pytest.mark.parametrize(("field", "value"), [("via_speeds", (0.5, 1.0)), ("via_speeds", (0.0, -1.0)),
+                                              ("via_speeds", (0.0, 2.0, 1.0)), ("via_accels", (1.0, 2.0)),
+                                              ("via_accels", (0.0, float("nan")))])
+def test_config_rejects_a_bad_via_grid(field: str, value: tuple[float, ...]) -> None:
+    """The grid must hold 0 (the rest-to-rest fallback) and increase (the search steps to neighbours)."""
     with pytest.raises(PlanError, match=field):
         dataclasses.replace(PlanConfig(), **{field: value}).validate()

@@ -60,15 +60,16 @@ def test_limit_check_flags_a_position_outside_the_joint_range(plan: Plan) -> Non
     assert len(viol) == 1 and viol[0].startswith("joint 2 position")
 
 
-@pytest.mark.parametrize(("shift_mm", "flagged"), [(3.0, True), (1.5, False)])
-def test_vertical_check_flags_a_line_3mm_away(plan: Plan, shift_mm: float, flagged: bool) -> None:
-    """Checked against lines moved sideways by ``shift_mm``: every vertical sample is that far off (+- the plan's
-    own sub-millimetre deviation), so 3 mm breaks the 2 mm tolerance and 1.5 mm does not."""
+@pytest.mark.parametrize("flagged", [True, False])
+def test_vertical_check_flags_a_line_moved_away(plan: Plan, flagged: bool) -> None:
+    """Checked against lines moved sideways by d: every vertical sample is d off, +- the plan's own deviation
+    ``own``; d = 2 mm + own + 0.5 mm breaks the 2 mm tolerance, d = 2 mm - own - 0.2 mm does not."""
     st = plan.station
-    d = shift_mm * 1e-3
+    _, own = check_vertical(plan.trajectory, plan.moves, st, 0.002)
+    d = 0.002 + own + 0.0005 if flagged else 0.002 - own - 0.0002
+    assert d > 0
     moved = st.with_grid([(x + d * 0.6, y + d * 0.8, z) for x, y, z in st.tower_origins], st.height_step,
                          st.tool_yaw)
-    _, own = check_vertical(plan.trajectory, plan.moves, st, 0.002)
     viol, worst = check_vertical(plan.trajectory, plan.moves, moved, 0.002)
     assert d - own <= worst <= d + own
     assert bool(viol) == flagged

@@ -6,6 +6,7 @@ Both return human-readable violations (empty: the check passed); :func:`ur3hanoi
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import lru_cache
 
 import numpy as np
 
@@ -13,7 +14,7 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.grid import contact_point_world
 from ur3hanoi.hanoi import Move
 from ur3hanoi.plan.types import VERTICAL_PHASES, KinematicLimits, Phase, Segment, Trajectory
-from ur3hanoi.robot import dh_fk, load_ur3
+from ur3hanoi.robot import DH_A, DH_D, load_ur3
 from ur3hanoi.station import Station
 
 LIMIT_RTOL = 1e-6  # relative tolerance of the velocity/acceleration/jerk checks
@@ -52,17 +53,41 @@ def check_limits(tr: Trajectory, segments: Sequence[Segment], limits: KinematicL
     return out
 
 
+@lru_cache(maxsize=32)
+def _tcp_frames(station: Station) -> tuple[tuple[float, float, float], FloatArray, FloatArray]:
+    """The suction point in the flange frame (tool0) [m], and the world rotation and translation of ``base``."""
+    t = load_ur3(station.tool, station.limits).T_flange_tcp("tool0").translation
+    T_wb = station.T_world_base
+    return (float(t[0]), float(t[1]), float(t[2])), T_wb.rotation.copy(), T_wb.translation.copy()
+
+
 def tcp_positions_world(station: Station, q: FloatArray) -> FloatArray:
-    """World position [m] of the suction point at every row of ``q`` (N, 6): batched UR3 DH forward kinematics.
+    """World position [m] of the suction point at every row of ``q`` (N, 6): the UR3's DH forward kinematics in
+    closed form (the chain of ``dh_fk`` multiplied out: joints 2-4 are parallel, so they add up to planar angles).
 
     Same kinematics as ``Ur3Model.fk(q, "tcp")`` (the URDF and the DH table agree to ~1e-11 m), without a
-    per-sample Pinocchio call.
+    per-sample Pinocchio call, and several times cheaper than the batched 4x4 products of ``dh_fk``: the vertical
+    line of every leg is checked with it at 1 kHz.
     """
-    T = dh_fk(q)
-    t_flange_tcp = load_ur3(station.tool, station.limits).T_flange_tcp("tool0").translation
-    p_base = T[:, :3, :3] @ t_flange_tcp + T[:, :3, 3]
-    T_wb = station.T_world_base
-    return p_base @ T_wb.rotation.T + T_wb.translation
+    q = np.asarray(q, dtype=float).reshape(-1, 6)
+    (tx, ty, tz), R_wb, p_wb = _tcp_frames(station)
+    d1, _, _, d4, d5, d6 = DH_D
+    a2, a3 = DH_A[1], DH_A[2]
+    c1, s1 = np.cos(q[:, 0]), np.sin(q[:, 0])
+    q23 = q[:, 1] + q[:, 2]
+    q234 = q23 + q[:, 3]
+    c234, s234 = np.cos(q234), np.sin(q234)
+    c5, s5 = np.cos(q[:, 4]), np.sin(q[:, 4])
+    c6, s6 = np.cos(q[:, 5]), np.sin(q[:, 5])
+    # Frame 1 (after joint 1 and its alpha = pi/2): joints 2-4 rotate about its z axis. Tool offset rotated by
+    # Rz(q234) Ry(-q5) Rz(q6).
+    wx, wy = c6 * tx - s6 * ty, s6 * tx + c6 * ty
+    ux, uz = c5 * wx - s5 * tz, s5 * wx + c5 * tz
+    x = a2 * np.cos(q[:, 1]) + a3 * np.cos(q23) + d5 * s234 - d6 * s5 * c234 + c234 * ux - s234 * wy
+    y = a2 * np.sin(q[:, 1]) + a3 * np.sin(q23) - d5 * c234 - d6 * s5 * s234 + s234 * ux + c234 * wy
+    z = d4 + d6 * c5 + uz
+    p_base = np.stack([c1 * x + s1 * z, s1 * x - c1 * z, y + d1], axis=1)
+    return p_base @ R_wb.T + p_wb
 
 
 def check_vertical(tr: Trajectory, moves: Sequence[Move], station: Station, tol_m: float) -> tuple[list[str], float]:

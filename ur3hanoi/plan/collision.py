@@ -1,15 +1,18 @@
 """Clearance checks of a sampled plan: the UR3's collision meshes, the suction cup and the carried block against
 the table and the resting blocks (Pinocchio geometry, coal distances), decimated with a proven margin.
 
-The pair rules (which pairs are checked in which phase, and which are excluded as contact by design) are the
-functions :func:`_resting_blocks`, :func:`_robot_pairs` and :func:`_carried_block_pairs`; see
-:class:`CollisionScene` for the geometry, the required distances and the decimation argument.
+The rules (which clearances are required in which phase, and which are excluded as contact by design) are
+:func:`clearance_rules` over the resting blocks of :func:`resting_blocks`; see :class:`CollisionScene` for the
+geometry, the required distances and the decimation argument. :func:`check_collisions` checks a sampled
+trajectory (any trajectory); the planner checks its segments with :mod:`ur3hanoi.plan.clearance`, which applies the
+same rules once per distinct segment.
 """
 
 from __future__ import annotations
 
 import itertools
 from collections.abc import Sequence
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
@@ -141,6 +144,12 @@ class CollisionScene:
     def name(self, gid: int) -> str:
         return self.gm.geometryObjects[gid].name
 
+    def movers(self, mover: str) -> list[int]:
+        """Geometry ids of a rule's mover: "robot" (every robot geometry but the base), "cup" or "carried"."""
+        if mover == "robot":
+            return [g for g in self.robot_geoms if g != self.base_geom]
+        return [self.cup] if mover == "cup" else [self.carried]
+
 
 @lru_cache(maxsize=8)
 def _collision_scene(station: Station, n_blocks: int) -> CollisionScene:
@@ -150,7 +159,7 @@ def _collision_scene(station: Station, n_blocks: int) -> CollisionScene:
 
 
 
-def _resting_blocks(stacks: Sequence[Sequence[Sequence[int]]], moves: Sequence[Move], mi: int,
+def resting_blocks(stacks: Sequence[Sequence[Sequence[int]]], moves: Sequence[Move], mi: int,
                     ph: Phase) -> dict[int, Slot]:
     """Block -> slot of every block at rest during phase ``ph`` of move ``mi`` (-1: before the first move, or on
     the way home): the carried block is not at rest; a just-placed block rests on its destination."""
@@ -167,39 +176,55 @@ def _resting_blocks(stacks: Sequence[Sequence[Sequence[int]]], moves: Sequence[M
     return slots
 
 
-def _robot_pairs(scene: CollisionScene, ph: Phase, m: Move | None, slots: dict[int, Slot]) -> list[Pair]:
-    """Robot geometry and cup vs the table and every resting block (> 0), except: the base (mounted on the table),
-    the cup vs the table while at contact (vertical and dwell phases), the cup vs the block it picks or placed."""
-    pairs: list[Pair] = []
-    for g in [*scene.robot_geoms, scene.cup]:
-        if g == scene.base_geom:
-            continue
-        if not (g == scene.cup and ph in (*VERTICAL_PHASES, *DWELL_PHASES)):
-            pairs.append(((g, scene.table), 0.0))
-        for b in slots:
-            if g == scene.cup and m is not None and b == m.block and ph in _CUP_ON_MOVED_BLOCK:
-                continue
-            pairs.append(((g, scene.blocks[b]), 0.0))
-    return pairs
+@dataclass(frozen=True)
+class Rule:
+    """Required clearances of one ``mover`` ("robot": every robot geometry but the base, "cup", or "carried")
+    against each of ``blocks`` (resting blocks; None stands for the table), at least ``required_m`` [m] (0: strictly
+    positive)."""
+
+    mover: str
+    blocks: tuple[int | None, ...]
+    required_m: float
 
 
-def _carried_block_pairs(scene: CollisionScene, ph: Phase, m: Move, slots: dict[int, Slot],
-                         clearance_m: float) -> list[Pair]:
-    """The carried block vs the table (> 0, while carrying across) and every resting block (>= ``clearance_m``),
-    except the block it rests on at contact (stacked layout: the one under its source while lifting, under its
-    destination while descending to place)."""
-    pairs: list[Pair] = []
-    if ph == Phase.CARRY:
-        pairs.append(((scene.carried, scene.table), 0.0))
+def clearance_rules(station: Station, ph: Phase, m: Move | None, slots: dict[int, Slot],
+                    clearance_m: float) -> list[Rule]:
+    """The clearances required during phase ``ph`` of move ``m`` (None: before the first move / on the way home)
+    with the resting blocks ``slots`` (block -> slot).
+
+    Robot geometry and cup vs the table and every resting block (> 0), except: the base (mounted on the table),
+    the cup vs the table while at contact (vertical and dwell phases), the cup vs the block it picks or placed.
+    While carrying: the carried block vs the table (> 0, while carrying across) and every resting block
+    (>= ``clearance_m``), except the block it rests on at contact (stacked layout: the one under its source while
+    lifting, under its destination while descending to place).
+    """
+    blocks = tuple(slots)
+    cup_on = m.block if m is not None and ph in _CUP_ON_MOVED_BLOCK else None
+    cup_table: tuple[int | None, ...] = () if ph in (*VERTICAL_PHASES, *DWELL_PHASES) else (None,)
+    rules = [Rule("robot", (None, *blocks), 0.0),
+             Rule("cup", (*cup_table, *(b for b in blocks if b != cup_on)), 0.0)]
+    if m is None or not ph.carrying:
+        return rules
     under = None
-    if scene.station.layout == "stacked":
+    if station.layout == "stacked":
         if ph == Phase.LIFT and m.from_height > 0:
             under = (m.from_tower, m.from_height - 1)
         if ph == Phase.DESCEND_PLACE and m.to_height > 0:
             under = (m.to_tower, m.to_height - 1)
-    for b, slot in slots.items():
-        if slot != under:
-            pairs.append(((scene.carried, scene.blocks[b]), clearance_m))
+    if ph == Phase.CARRY:
+        rules.append(Rule("carried", (None,), 0.0))
+    rules.append(Rule("carried", tuple(b for b, slot in slots.items() if slot != under), clearance_m))
+    return rules
+
+
+def _pairs(scene: CollisionScene, rules: Sequence[Rule]) -> list[Pair]:
+    """The scene's geometry pairs of ``rules`` (a robot rule expands to every robot geometry but the base)."""
+    pairs: list[Pair] = []
+    for r in rules:
+        for b in r.blocks:
+            target = scene.table if b is None else scene.blocks[b]
+            for g in scene.movers(r.mover):
+                pairs.append(((g, target), r.required_m))
     return pairs
 
 
@@ -240,11 +265,9 @@ def check_collisions(tr: Trajectory, moves: Sequence[Move], station: Station, n_
     for run in np.split(np.arange(len(tr.t)), change):
         mi, ph = int(tr.move_index[run[0]]), Phase(int(tr.phase[run[0]]))
         m = moves[mi] if mi >= 0 else None
-        slots = _resting_blocks(stacks, moves, mi, ph)
+        slots = resting_blocks(stacks, moves, mi, ph)
         scene.place_blocks(slots)
-        pairs = _robot_pairs(scene, ph, m, slots)
-        if m is not None and ph.carrying:
-            pairs += _carried_block_pairs(scene, ph, m, slots, config.clearance_m)
+        pairs = _pairs(scene, clearance_rules(station, ph, m, slots, config.clearance_m))
         if not pairs:
             continue
         keys = [p for p, _ in pairs]

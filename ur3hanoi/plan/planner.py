@@ -1,4 +1,9 @@
-"""The planning pipeline: waypoints -> chained Ruckig segments -> samples -> safety checks -> :class:`Plan`."""
+"""The planning pipeline: hops -> connections (chained Ruckig segments) -> samples -> safety checks -> :class:`Plan`.
+
+Per station and planning limits, the legs and connections are built once and cached
+(:func:`~ur3hanoi.plan.connections.station_planner`): the first plan on a station pays the set-up (IK table,
+vertical paths, the legs and connections it uses), later plans reuse everything they share with it.
+"""
 
 from __future__ import annotations
 
@@ -7,9 +12,10 @@ from collections.abc import Sequence
 
 from ur3hanoi.errors import PlanError
 from ur3hanoi.hanoi import Move, check_sequence, solve_hanoi
-from ur3hanoi.plan.builder import SegmentBuilder
+from ur3hanoi.plan.baseline import exact_vertical_motion_s, stop_and_go_motion_s
+from ur3hanoi.plan.builder import SegmentBuilder, plan_hops
 from ur3hanoi.plan.checks import check_limits, check_vertical
-from ur3hanoi.plan.collision import check_collisions
+from ur3hanoi.plan.clearance import check_segments
 from ur3hanoi.plan.sampling import sample
 from ur3hanoi.plan.types import Plan, PlanConfig
 from ur3hanoi.plan.waypoints import build_waypoints
@@ -24,18 +30,21 @@ def plan_moves(station: Station, moves: Sequence[Move], config: PlanConfig | Non
     n_blocks = n_blocks if n_blocks is not None else (max(m.block for m in moves) + 1 if moves else 0)
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    wp = build_waypoints(station)
+    build_waypoints(station)
     timings["waypoints"] = time.perf_counter() - t0
-    builder = SegmentBuilder(station, wp, config)
+    t0 = time.perf_counter()
+    builder = SegmentBuilder(station, config)
     limits = builder.limits
-    t0 = time.perf_counter()
-    segments = builder.build(moves)
+    ruckig_before = builder.planner.ruckig_seconds
+    hops = plan_hops(station, moves, n_blocks, start, config.clearance_m)
+    segments = builder.build(hops)
     timings["build"] = time.perf_counter() - t0
-    timings["ruckig"] = builder.ruckig_seconds
-    # Stop-and-go reference: the same waypoints and limits, zero velocity at every waypoint.
+    timings["ruckig"] = builder.planner.ruckig_seconds - ruckig_before
     t0 = time.perf_counter()
-    stop_go = SegmentBuilder(station, wp, config, pass_through=False).build(moves)[-1].t_end
-    timings["stop_and_go"] = time.perf_counter() - t0
+    dwell_total = 2 * len(moves) * config.dwell_s
+    stop_go = stop_and_go_motion_s(builder.planner, hops) + dwell_total
+    exact_vertical = exact_vertical_motion_s(builder.planner, hops) + dwell_total
+    timings["baselines"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     tr = sample(segments, config.rate_hz)
     timings["sampling"] = time.perf_counter() - t0
@@ -46,14 +55,15 @@ def plan_moves(station: Station, moves: Sequence[Move], config: PlanConfig | Non
     timings["checks"] = time.perf_counter() - t0
     if config.check_collisions and moves:
         t0 = time.perf_counter()
-        violations += check_collisions(tr, moves, station, n_blocks, start, config, limits)
+        violations += check_segments(segments, moves, station, n_blocks, start, config, limits)
         timings["collision"] = time.perf_counter() - t0
     duration = segments[-1].t_end
-    dwell_total = 2 * len(moves) * config.dwell_s
     plan = Plan(station=station, moves=tuple(moves), trajectory=tr, stop_and_go_duration_s=stop_go, config=config,
                 segments=tuple(segments), limits=limits, violations=tuple(violations), duration_s=duration,
                 dwell_total_s=dwell_total, stop_and_go_motion_s=stop_go - dwell_total, start=start, end=end,
-                n_blocks=n_blocks, timings_s=timings)
+                n_blocks=n_blocks, timings_s=timings, exact_vertical_stop_and_go_duration_s=exact_vertical,
+                exact_vertical_stop_and_go_motion_s=exact_vertical - dwell_total,
+                vertical_deviation_m=max((leg.deviation_m for leg in builder.legs_used), default=0.0))
     if violations and config.raise_on_violation:
         more = f" (+{len(violations) - 1} more)" if len(violations) > 1 else ""
         raise PlanError(f"plan on {station.name} violates a safety check: {violations[0]}{more}")

@@ -137,6 +137,22 @@ def _at_times(traj: RuckigTrajectory, tau: FloatArray) -> tuple[FloatArray, Floa
     return states[:, 0], states[:, 1], states[:, 2], _profile_jerk(traj, tau)
 
 
+def evaluate(traj: RuckigTrajectory, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """(position, velocity, acceleration), each (N, dofs), of one Ruckig trajectory at local times ``tau`` (N,)
+    [s], non-decreasing and within [0, duration]: the vectorised ``at_time`` (same arithmetic, see above).
+
+    Used by the approach legs to check the vertical line densely (1 kHz) without a per-sample binding call.
+    """
+    profs = traj.profiles[0]
+    if any(prof.brake.duration > 0.0 for prof in profs):
+        x, xd, xdd, _ = _at_times(traj, tau)
+        return x, xd, xdd
+    n = len(tau)
+    q, qd, qdd, _ = _ProfileTable.of([profs]).evaluate(np.zeros(n, dtype=np.intp), np.zeros(1, dtype=np.intp),
+                                                       np.asarray(tau, dtype=float))
+    return q.T, qd.T, qdd.T
+
+
 class _StackedPaths:
     """The nodes of several :class:`VerticalPath` stacked (joint-major), to evaluate many paths in one call."""
 

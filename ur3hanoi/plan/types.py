@@ -5,6 +5,7 @@ All are frozen dataclasses (or an IntEnum); the modules of :mod:`ur3hanoi.plan` 
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from enum import IntEnum
@@ -23,7 +24,11 @@ from ur3hanoi.station import Station
 if TYPE_CHECKING:
     from ur3hanoi.plan.vertical import VerticalPath
 
-DEFAULT_VIA_FRACTIONS: tuple[float, ...] = (1.0, 0.8, 0.6, 0.4, 0.2, 0.0)
+# The via grid at the above poses (see ur3hanoi.plan.legs): path speeds in units of vb = L / T0 and path
+# accelerations in units of vb / T0 (L: approach length, T0: the slot's joint-space rest-to-rest leg). The lab
+# stations' optima lie at 1.25-2.5 vb and 1-4 vb / T0; 0 must be in both (the rest-to-rest fallback).
+DEFAULT_VIA_SPEEDS: tuple[float, ...] = (0.0, 0.5, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5, 3.0)
+DEFAULT_VIA_ACCELS: tuple[float, ...] = (-2.0, 0.0, 1.0, 2.0, 3.0, 4.0, 6.0)
 
 
 class Phase(IntEnum):
@@ -100,12 +105,14 @@ class PlanConfig:
         dwell_s: time at rest at each contact pose for the suction to build up / release [s].
         v_max, a_max, j_max: per-joint overrides [rad/s, rad/s^2, rad/s^3] (None: the station's JointLimits).
         pass_through: False plans stop-and-go (zero velocity at every waypoint).
-        via_fractions: candidate fractions of the largest feasible vertical speed at the "above" via points.
+        blend: start the motion across inside the vertical corridor (see :mod:`ur3hanoi.plan.blend`).
+        via_speeds, via_accels: the grid of via states at the above poses, in units of each slot's own rest-to-rest
+            leg (see :mod:`ur3hanoi.plan.legs`); both must contain 0.
         vertical_tol_m: allowed distance [m] of the suction point from the vertical line in vertical phases.
         clearance_m: required clearance [m] of the carried block from every other block.
         check_collisions: run the Pinocchio/coal clearance checks (slower; limits are always checked).
-        collision_rate_hz: coarse rate [Hz] of the clearance check; refined to every sample where the margin is
-            not provably enough (see :class:`ur3hanoi.plan.collision.CollisionScene`).
+        collision_rate_hz: coarse rate [Hz] of the clearance check; refined down to 1 ms where the margin is not
+            provably enough (see :mod:`ur3hanoi.plan.clearance`).
         raise_on_violation: raise PlanError on the first violation list (False: return it in Plan.violations).
     """
 
@@ -116,7 +123,9 @@ class PlanConfig:
     a_max: tuple[float, ...] | None = None
     j_max: tuple[float, ...] | None = None
     pass_through: bool = True
-    via_fractions: tuple[float, ...] = DEFAULT_VIA_FRACTIONS
+    blend: bool = True
+    via_speeds: tuple[float, ...] = DEFAULT_VIA_SPEEDS
+    via_accels: tuple[float, ...] = DEFAULT_VIA_ACCELS
     vertical_tol_m: float = 0.002
     clearance_m: float = 0.005
     check_collisions: bool = True
@@ -135,8 +144,13 @@ class PlanConfig:
             v = getattr(self, name)
             if v is not None and (len(v) != N_JOINTS or not all(math.isfinite(x) and x > 0 for x in v)):
                 raise PlanError(f"{name} = {v!r} is invalid: expected {N_JOINTS} positive numbers")
-        if not self.via_fractions or not all(0.0 <= f <= 1.0 for f in self.via_fractions):
-            raise PlanError(f"via_fractions = {self.via_fractions!r} is invalid: expected values in [0, 1]")
+        for name in ("via_speeds", "via_accels"):
+            grid = getattr(self, name)
+            lo = 0.0 if name == "via_speeds" else -math.inf
+            if (0.0 not in grid or not all(math.isfinite(x) and x >= lo for x in grid)
+                    or any(b <= a for a, b in itertools.pairwise(grid))):
+                raise PlanError(f"{name} = {grid!r} is invalid: expected increasing finite values including 0"
+                                + (", none negative" if name == "via_speeds" else ""))
         for name in ("collision_rate_hz", "vertical_tol_m", "clearance_m"):
             x = getattr(self, name)
             if not (math.isfinite(x) and x > 0.0):  # NaN compares False everywhere: test finiteness explicitly
@@ -156,9 +170,11 @@ class Segment:
     """One Ruckig segment (or a dwell) of the plan.
 
     ``trajectory`` is the Ruckig trajectory of the segment (time 0 = ``t_start``), None for a dwell at rest at
-    ``q_start``. For a vertical leg ``path`` is set and ``trajectory`` is the 1-DoF Ruckig trajectory of the path
-    coordinate s [m] (see :class:`ur3hanoi.plan.vertical.VerticalPath`); otherwise it is 6-DoF in joint space.
-    ``target`` names the waypoint reached at the segment's end (1-based tower/height).
+    ``q_start``. Usually 6-DoF in joint space; for a vertical leg that follows the line exactly (the rest-to-rest
+    fallback of :mod:`ur3hanoi.plan.legs`) ``path`` is set and ``trajectory`` is the 1-DoF Ruckig trajectory of the
+    path coordinate s [m] (see :class:`ur3hanoi.plan.vertical.VerticalPath`). ``target`` names the waypoint reached
+    at the segment's end (1-based tower/height): ``above``, ``on``, ``over`` (risen over taller towers), ``via``
+    (an interior point of a vertical leg) or ``home``.
     """
 
     phase: Phase
@@ -185,15 +201,23 @@ class Plan:
     Attributes:
         station, moves, config: the station, the move sequence and the settings planned with.
         trajectory: the sampled motion.
-        stop_and_go_duration_s: cycle time [s] of the same waypoints with zero velocity at each.
+        stop_and_go_duration_s: cycle time [s] of the honest baseline: joint-space Ruckig from rest to rest between
+            the same waypoints under the same limits, with the same dwells (it ignores the vertical line; see
+            :mod:`ur3hanoi.plan.baseline`).
         segments: the chained Ruckig segments and dwells.
         limits: the planning limits actually used.
         violations: safety check failures (empty for a valid plan; non-empty only if not raise_on_violation).
         duration_s: exact cycle time [s] (the sampled trajectory ends on the first sample at or after it).
         dwell_total_s: time at rest in the grasp/release dwells [s].
-        stop_and_go_motion_s: stop-and-go cycle minus the same dwells [s].
+        stop_and_go_motion_s: the honest baseline's cycle minus the same dwells [s].
         start, end, n_blocks: the instance (0-based towers).
-        timings_s: wall-clock planning times [s]: "ruckig" (calculate calls), "sampling", "checks", "collision".
+        timings_s: wall-clock planning times [s]: "build" (connections, including their Ruckig calls; "ruckig" is
+            that share), "baselines", "sampling", "checks", "collision".
+        exact_vertical_stop_and_go_duration_s: cycle time [s] of stop-and-go with approach and retreat following
+            the vertical line exactly (1-DoF path timing with constant limits), same dwells: the old reference.
+        exact_vertical_stop_and_go_motion_s: the same minus the dwells [s].
+        vertical_deviation_m: worst distance [m] of the suction point from the vertical line over the plan's
+            approach and retreat legs, by forward kinematics at 1 kHz.
     """
 
     station: Station
@@ -211,6 +235,9 @@ class Plan:
     end: int = 0
     n_blocks: int = 0
     timings_s: dict[str, float] = field(default_factory=dict)
+    exact_vertical_stop_and_go_duration_s: float = 0.0
+    exact_vertical_stop_and_go_motion_s: float = 0.0
+    vertical_deviation_m: float = 0.0
 
     @property
     def motion_s(self) -> float:
@@ -219,7 +246,7 @@ class Plan:
 
     @property
     def motion_saving(self) -> float:
-        """Relative motion-time saving over stop-and-go (0.15 = 15 % faster)."""
+        """Relative motion-time saving over the honest stop-and-go baseline (0.15 = 15 % faster)."""
         return 1.0 - self.motion_s / self.stop_and_go_motion_s if self.stop_and_go_motion_s > 0 else 0.0
 
     def to_json_dict(self) -> dict[str, Any]:

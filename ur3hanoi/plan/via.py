@@ -1,83 +1,87 @@
-"""Via speeds at the "above" points: a slot's candidate vertical legs, and the search for the best (exit, entry) pair.
+"""Via states at the "above" points: the search for a connection's best (exit cell, entry cell).
 
-The robot passes through the above points without stopping, moving along the vertical line at a speed ``sigma``
-[m/s] there. A horizontal segment joins the exit leg of the slot it leaves (lift/retreat) and the entry leg of the
-slot it enters (descend); its cost is the summed duration of the three. :func:`best_via_pair` searches the grid
-of (exit candidate, entry candidate) for the least cost.
+A connection joins the exit leg of the slot it leaves (lift/retreat, ending at the above pose in the via state of
+its cell), the joint-space motion across, and the entry leg of the slot it enters (descend, starting at the above
+pose in the via state of its cell); its cost is the sum ``exit(c0) + across(c0, c1) + entry(c1)``. The cells of
+each slot form a small grid (:class:`~ur3hanoi.plan.legs.SlotLegs`): :func:`best_cells` searches the product.
+
+Each leg has a cheap lower bound (one Ruckig calculation) and an exact duration (the verified leg through interior
+points: a small optimisation). The search descends on the costs with the bounds in place of the legs it has not
+built yet; where it stops, it builds the legs of that candidate (the exit leg first: an infeasible one makes the
+entry leg moot) and descends again with what it learnt, until it stops on a candidate whose legs are both built:
+a local minimum of the exact costs among the bounds of its neighbours. Only what the search itself learnt enters
+its decisions (never what another connection built), so the result is a function of the connection alone.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
-from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+
+Cell = tuple[int, int]
+Pair = tuple[int, int, int, int]  # exit cell, entry cell
+# Descents per search: each one after the first follows a leg found infeasible; the lab's connections take at most 4.
+MAX_DESCENTS = 8
 
 
-@dataclass(frozen=True)
-class Leg:
-    """A vertical leg's duration [s] for one via speed sigma [m/s] (descend and lift are time-reverses)."""
-
-    sigma: float
-    duration: float
-
-
-class LegCandidates:
-    """A slot's candidate legs, fastest via speed first.
-
-    ``solve(sigma)`` returns the leg's duration [s], or None if that via speed is infeasible (the candidate is
-    dropped). A leg is solved on first use: the search usually needs only the fastest two or three.
-    """
-
-    def __init__(self, speeds: Iterable[float], solve: Callable[[float], float | None],
-                 solved: Iterable[Leg] = ()) -> None:
-        self._speeds = iter(speeds)
-        self._solve = solve
-        self._legs: list[Leg] = list(solved)
-
-    @classmethod
-    def at_rest(cls) -> LegCandidates:
-        """The single candidate of home: at rest (sigma 0), no vertical leg (duration 0)."""
-        return cls([], lambda _: None, [Leg(0.0, 0.0)])
-
-    def get(self, i: int) -> Leg | None:
-        """The i-th feasible candidate (None: fewer than i + 1 exist)."""
-        while len(self._legs) <= i:
-            sigma = next(self._speeds, None)
-            if sigma is None:
-                return None
-            duration = self._solve(sigma)
-            if duration is not None:
-                self._legs.append(Leg(sigma, duration))
-        return self._legs[i]
-
-    def count(self) -> int:
-        """Number of feasible candidates (solves them all)."""
-        while self.get(len(self._legs)) is not None:
-            pass
-        return len(self._legs)
-
-
-def best_via_pair(exits: LegCandidates, entries: LegCandidates,
-                  cost: Callable[[int, int], float]) -> tuple[int, int]:
-    """The (exit i, entry j) candidate pair of least ``cost(i, j)`` (inf: infeasible; ``cost`` should memoize).
-
-    Descent over the candidate grid from the fastest pair (0, 0), stepping to the best improving 4-neighbour: the
-    summed duration is unimodal over this grid in practice (the optimum has one of the two speeds at its largest
-    candidate), and the descent found the same optimum as the full 6 x 6 search on every connection of the lab
-    stations (all pairs, N = 1..3) and of a 10-level grid (N = 1..7), with ~1/7 of the Ruckig calls. If the
-    descent ends on an infeasible pair (nothing feasible near the fastest pair), every pair is tried.
-    """
-    cur = (0, 0)
+def _descend(cur: Pair, dims: Sequence[int], cost: Callable[[Pair], float]) -> Pair:
+    """Steepest descent over the 8 grid neighbours (first best on ties) from ``cur``."""
     while True:
-        i, j = cur
-        nbrs = [(i + di, j + dj) for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1))
-                if i + di >= 0 and j + dj >= 0 and exits.get(i + di) is not None and entries.get(j + dj) is not None]
-        nxt = min(nbrs, key=lambda ij: cost(*ij), default=cur)
-        if not cost(*nxt) < cost(*cur):
-            break
-        cur = nxt
-    if math.isinf(cost(*cur)):
-        cur = min(itertools.product(range(exits.count()), range(entries.count())), key=lambda ij: cost(*ij),
-                  default=cur)
-    return cur
+        best_cost, best = cost(cur), cur
+        for d, n in enumerate(dims):
+            for step in (-1, 1):
+                k = cur[d] + step
+                if 0 <= k < n:
+                    nb: Pair = (*cur[:d], k, *cur[d + 1:])  # type: ignore[assignment]
+                    c = cost(nb)
+                    if c < best_cost:
+                        best_cost, best = c, nb
+        if best == cur:
+            return cur
+        cur = best
+
+
+def best_cells(dims: Pair, start: Pair, bounds: tuple[Callable[[Cell], float], Callable[[Cell], float]],
+               exacts: tuple[Callable[[Cell], float], Callable[[Cell], float]], across: Callable[[Pair], float],
+               fallback: Pair) -> Pair:
+    """The (exit cell, entry cell) of least exact cost found by bound-guided descent from ``start``.
+
+    ``dims``: grid sizes (exit speeds, exit accelerations, entry speeds, entry accelerations). ``bounds[k](c) <=
+    exacts[k](c)`` for the exit (k = 0) and entry (k = 1) legs; inf marks an infeasible leg or motion across. If the
+    descent ends on an infeasible candidate, it restarts from the least-cost candidate seen; after
+    :data:`MAX_DESCENTS` descents it takes the best candidate whose legs it built. If nothing feasible is left, the
+    result is ``fallback``, which the caller guarantees to be feasible (the rest-to-rest legs).
+    """
+    known: tuple[dict[Cell, float], dict[Cell, float]] = ({}, {})
+    seen: set[Pair] = set()
+
+    def leg(k: int, c: Cell) -> float:
+        return known[k][c] if c in known[k] else bounds[k](c)
+
+    def cost(p: Pair) -> float:
+        seen.add(p)
+        legs = leg(0, (p[0], p[1])) + leg(1, (p[2], p[3]))
+        return legs + across(p) if math.isfinite(legs) else math.inf
+
+    cur = start
+    for _ in range(MAX_DESCENTS):
+        cur = _descend(cur, dims, cost)
+        c0, c1 = (cur[0], cur[1]), (cur[2], cur[3])
+        if c0 not in known[0]:
+            known[0][c0] = exacts[0](c0)
+            if math.isfinite(known[0][c0]) and c1 not in known[1]:
+                known[1][c1] = exacts[1](c1)
+            continue
+        if c1 not in known[1] and math.isfinite(known[0][c0]):
+            known[1][c1] = exacts[1](c1)
+            continue
+        if math.isfinite(cost(cur)):
+            return cur
+        finite = sorted((cost(p), p) for p in sorted(seen) if math.isfinite(cost(p)))
+        if not finite:
+            return fallback
+        cur = finite[0][1]
+    # Out of descents (many infeasible legs around): the best candidate whose legs are both built, else the fallback.
+    built = sorted((cost(p), p) for p in sorted(seen)
+                   if (p[0], p[1]) in known[0] and (p[2], p[3]) in known[1] and math.isfinite(cost(p)))
+    return built[0][1] if built else fallback

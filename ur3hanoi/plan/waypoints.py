@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
@@ -24,12 +24,22 @@ class Waypoints:
     vertical: tuple[tuple[VerticalPath, ...], ...]  # [tower][height]
 
 
-@lru_cache(maxsize=32)
+def geometry_key(station: Station) -> Station:
+    """``station`` without its name, source file and file digest: the key of every per-station cache (they do not
+    change a motion; the rest of the calibration does, field by field)."""
+    return replace(station, name="", source="", sha256="")
+
+
 def build_waypoints(station: Station, node_step_m: float = 0.002) -> Waypoints:
     """Table by IK on the home branch, plus the vertical path of every slot (nodes every <= ``node_step_m`` [m]).
 
-    Cached per station: every plan on a station reuses them.
+    Cached per station geometry (:func:`geometry_key`): every plan on a station reuses them.
     """
+    return _build_waypoints(geometry_key(station), node_step_m)
+
+
+@lru_cache(maxsize=32)
+def _build_waypoints(station: Station, node_step_m: float) -> Waypoints:
     table = generate_table(station)
     robot = load_ur3(station.tool, station.limits)
     n = max(2, math.ceil(station.approach / node_step_m)) + 1
