@@ -10,7 +10,7 @@ import pytest
 
 from ur3hanoi.grid import ABOVE, ON
 from ur3hanoi.hanoi import solve_hanoi
-from ur3hanoi.plan import OfflineRuckig, PlanConfig, build_waypoints, plan_solve
+from ur3hanoi.plan import OfflineRuckig, PlanConfig, build_waypoints, plan_solve, plan_table
 from ur3hanoi.station import Station
 
 
@@ -40,3 +40,13 @@ def test_honest_baseline_is_rest_to_rest_between_the_waypoints(shipped_station: 
 def test_exact_vertical_is_slower_and_the_plan_beats_both(shipped_station: Station) -> None:
     plan = plan_solve(shipped_station, 0, 2, 3, PlanConfig(check_collisions=False))
     assert plan.motion_s < plan.stop_and_go_motion_s < plan.exact_vertical_stop_and_go_motion_s
+
+
+def test_honest_baseline_is_the_motion_of_the_lab_program_on_the_generated_table(shipped_station: Station) -> None:
+    """The baseline's motion time equals that of a real trajectory: the lab program's rest-to-rest moves through
+    the generated table (:func:`plan_table`, what ``solve --table`` executes)."""
+    st = shipped_station
+    plan = plan_solve(st, 0, 2, 3, PlanConfig(check_collisions=False))
+    table_plan = plan_table(st, build_waypoints(st).table, 0, 2, 3)
+    assert table_plan.motion_s == pytest.approx(plan.stop_and_go_motion_s, abs=1e-9)
+    assert plan.motion_s < table_plan.motion_s

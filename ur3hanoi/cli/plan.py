@@ -12,7 +12,7 @@ def add(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("plan", help="solve a Hanoi instance and time-parameterize the motion with Ruckig",
                        description="Solve the Tower of Hanoi from --start to --end (towers and blocks numbered "
                                    "from 1) and plan the whole motion with Ruckig under the UR3's limits "
-                                   "(pass-through above the towers, exact vertical approach), checked for "
+                                   "(pass-through above the towers, vertical approach within 2 mm), checked for "
                                    "joint limits, velocity/acceleration/jerk and clearances.")
     p.add_argument("--start", type=option(TOWER), required=True, help="start tower (1-based)")
     p.add_argument("--end", type=option(TOWER), required=True, help="end tower (1-based)")
@@ -27,7 +27,8 @@ def add(sub: argparse._SubParsersAction) -> None:
                    help=f"sample rate [Hz] in [{RATE.lo:g}, {RATE.hi:g}]: 125 (CB3, default) or 500 (e-Series)")
     p.add_argument("--dwell", type=option(DWELL), default=0.3,
                    help=f"suction dwell at each contact [s] in [{DWELL.lo:g}, {DWELL.hi:g}] (default 0.3)")
-    p.add_argument("--csv", metavar="FILE", help=f"write t,q1..q6,qd1..qd6,suction samples to FILE ({SYMLINK_NOTE})")
+    p.add_argument("--csv", metavar="FILE",
+                   help=f"write t,q1..q6,qd1..qd6,suction,move,phase samples to FILE ({SYMLINK_NOTE})")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a summary")
     p.add_argument("--no-collision", action="store_true", help="skip the (slower) clearance checks")
     p.set_defaults(func=run)
@@ -60,8 +61,9 @@ def run(args: argparse.Namespace) -> int:
         d = m.as_lab_dict()
         print(f"  {i:>3}. block {d['block']}: tower {d['from_tower']} height {d['from_height']} -> "
               f"tower {d['to_tower']} height {d['to_height']}")
-    print(f"cycle {plan.duration_s:.3f} s (motion {plan.motion_s:.3f} s), stop-and-go {plan.stop_and_go_duration_s:.3f}"
-          f" s (motion {plan.stop_and_go_motion_s:.3f} s): {100 * plan.motion_saving:.1f} % less motion time")
+    print(f"cycle {plan.duration_s:.3f} s (motion {plan.motion_s:.3f} s); joint-space stop-and-go baseline "
+          f"{plan.stop_and_go_duration_s:.3f} s (motion {plan.stop_and_go_motion_s:.3f} s): "
+          f"{100 * plan.motion_saving:.1f} % less motion time")
     print(f"{len(plan.trajectory.t)} samples at {plan.trajectory.rate_hz:g} Hz, speed {args.speed:g}; all limit and "
           "clearance checks passed" + (f"; wrote {shown(args.csv)}" if args.csv else ""))
     return 0

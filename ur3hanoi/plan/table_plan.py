@@ -126,8 +126,9 @@ def plan_table(station: Station, table: FloatArray, start: int, end: int, n_bloc
         table: ``Q[tower, height, k]`` (towers, heights, 2, 6) [rad], controller convention; NaN rows are
             missing entries.
         start, end, n_blocks: the instance (0-based towers).
-        config: speed, rate, dwell and limit overrides; ``pass_through``, ``via_fractions``, ``vertical_tol_m``
-            and the clearance settings do not apply (every waypoint is a stop, nothing is checked against a line).
+        config: speed, rate, dwell and limit overrides; ``pass_through``, ``via_speeds``/``via_accels``,
+            ``vertical_tol_m`` and the clearance settings do not apply (every waypoint is a stop, nothing is
+            checked against a line).
         where: how the table is named in messages (e.g. ``"lab2_data.yaml:sim_pos"``).
 
     Returns:
