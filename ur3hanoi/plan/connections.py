@@ -17,7 +17,6 @@ stale entry, and the results do not depend on what was planned before.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -154,7 +153,7 @@ class StationPlanner:
         if over1 is not None and slot1 is not None:
             middle.append((self.over_pose(slot1, over1), z, z))
         home: State = (self.wp.q_home, z, z)
-        fixed = self._chain(middle) if len(middle) > 1 else []
+        fixed = self.ruckig.chain(middle) if len(middle) > 1 else []
         if fixed is None:
             raise PlanError(f"Ruckig could not connect the over points of {slot0} and {slot1}")
         n0 = legs0.shape if legs0 is not None else (1, 1)
@@ -173,12 +172,12 @@ class StationPlanner:
                 states = states_across(ix)
                 chain = None
                 if states is not None:
-                    ends = self._chain(states[:2]) if middle else None
-                    tail = self._chain(states[-2:]) if middle else None
+                    ends = self.ruckig.chain(states[:2]) if middle else None
+                    tail = self.ruckig.chain(states[-2:]) if middle else None
                     if middle and ends is not None and tail is not None and fixed is not None:
                         chain = [*ends, *fixed, *tail]
                     elif not middle:
-                        chain = self._chain(states)
+                        chain = self.ruckig.chain(states)
                 dur = sum(t.duration for t in chain) if chain is not None else math.inf
                 across_memo[ix] = (float(dur), states or [], chain)
             return across_memo[ix][0]
@@ -249,15 +248,6 @@ class StationPlanner:
     @staticmethod
     def _name(slot: Slot | None) -> str:
         return "home" if slot is None else f"tower {slot[0] + 1} height {slot[1] + 1}"
-
-    def _chain(self, states: list[State]) -> list[RuckigTrajectory] | None:
-        out = []
-        for s0, s1 in itertools.pairwise(states):
-            traj = self.ruckig.solve(*s0, *s1).trajectory
-            if traj is None:
-                return None
-            out.append(traj)
-        return out
 
     # ----------------------------------------------------------------------------------------------- references
 

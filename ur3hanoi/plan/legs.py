@@ -39,7 +39,6 @@ order.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -205,7 +204,7 @@ class SlotLegs:
 
         def cost(x: Sequence[float]) -> float:
             mid = self._interior_states(points, x, down=True)
-            chain = self._chain([above, *mid, self.on]) if mid is not None else None
+            chain = self.ruckig.chain([above, *mid, self.on]) if mid is not None else None
             return sum(t.duration for t in chain) if chain is not None else math.inf
 
         n = len(fractions)
@@ -253,15 +252,6 @@ class SlotLegs:
             out.append(st)
         return out
 
-    def _chain(self, states: Sequence[State]) -> list[RuckigTrajectory] | None:
-        out = []
-        for s0, s1 in itertools.pairwise(states):
-            traj = self.ruckig.solve(*s0, *s1).trajectory
-            if traj is None:
-                return None
-            out.append(traj)
-        return out
-
     def _initial_guess(self, traj: RuckigTrajectory, fractions: Sequence[float]) -> list[float]:
         """Path speed and acceleration of the single joint-space segment where its suction point crosses each
         interior point's height (projected on the path tangent): the chain starts next to that segment."""
@@ -296,7 +286,7 @@ class SlotLegs:
             if mid is None:
                 return None, False
             states = [above, *mid, self.on] if down else [self.on, *mid[::-1], self.above_state(cell, down=False)]
-            chain = self._chain(states)
+            chain = self.ruckig.chain(states)
             if chain is None:
                 return None, False
             dev, dip = self.corridor(chain)
@@ -309,7 +299,7 @@ class SlotLegs:
 
     def _verified(self, states: Sequence[State]) -> Leg | None:
         """The chained leg through ``states`` if Ruckig solves it and it passes the corridor check, else None."""
-        chain = self._chain(states)
+        chain = self.ruckig.chain(states)
         if chain is None:
             return None
         dev, dip = self.corridor(chain)

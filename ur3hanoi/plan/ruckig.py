@@ -27,6 +27,7 @@ API:
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from collections.abc import Sequence
@@ -99,6 +100,16 @@ class OfflineRuckig:
             result, message = Result.ErrorInvalidInput, " ".join(str(e).replace("[ruckig]", "").split())
         self.seconds += time.perf_counter() - t0
         return RuckigSolution(result, traj if result in _SUCCESS else None, message)
+
+    def chain(self, states: Sequence[tuple[State, State, State]]) -> list[RuckigTrajectory] | None:
+        """One segment between each pair of consecutive states (q, v, a), or None as soon as one fails."""
+        out = []
+        for s0, s1 in itertools.pairwise(states):
+            traj = self.solve(*s0, *s1).trajectory
+            if traj is None:
+                return None
+            out.append(traj)
+        return out
 
 
 def to_rest(q0: State, v0: State, a0: State, limits: KinematicLimits) -> RuckigSolution:
