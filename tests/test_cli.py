@@ -45,6 +45,24 @@ def test_tables_writes_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
     assert "placo IK" in out.read_text()
 
 
+def test_tables_writes_into_a_students_own_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # Unknown keys, junk in the key being replaced, a malformed key not touched: all the student's, all kept.
+    out = tmp_path / "lab2_data.yaml"
+    mine = "# group 7\nhome_pos: [1, 2]\nextra_notes: {ok: yes}\nreal_pos: [[1]]   # not touched\n"
+    out.write_text(mine + "sim_pos: old\n")
+    assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(out)]) == 0, capsys.readouterr().err
+    text = out.read_text()
+    assert text.startswith(mine) and "sim_pos: old" not in text
+    assert main(["check-table", str(out), "--key", "sim_pos", "--calibration", "lab_sim"]) == 0
+    # Only a file whose top level is not a mapping is refused: one line, exit 2, the file untouched.
+    out.write_text("- home_pos\n- sim_pos\n")
+    capsys.readouterr()
+    assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(out)]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert "lab2_data.yaml: the top level is a list, not a mapping of keys" in err
+    assert out.read_text() == "- home_pos\n- sim_pos\n"
+
+
 def test_unreachable_grid_exits_2_with_one_line_and_writes_nothing(tmp_path: Path,
                                                                    capsys: pytest.CaptureFixture[str]) -> None:
     cal = _bad_calibration(tmp_path, tower_origins=[[0.25, -0.20, 0.0288], [0.25, -0.09, 0.0288],

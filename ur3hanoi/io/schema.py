@@ -134,9 +134,11 @@ class Field:
 
 @dataclass(frozen=True)
 class Record:
-    """A mapping with exactly the given keys (optional ones may be absent); any other key is an error."""
+    """A mapping with the given keys (optional ones may be absent). Any other key is an error, unless ``others``:
+    then other keys are the file owner's and hold anything."""
 
     fields: Mapping[str, Field] = field(default_factory=dict)
+    others: bool = False
 
     def expected(self) -> str:
         return f"a mapping with keys {', '.join(self.fields)}"
@@ -163,6 +165,14 @@ def suggest(key: object, valid: list[str]) -> str | None:
     return best
 
 
+def describe_type(value: Any) -> str:
+    """``"a list"``, ``"a str"``, ``"an empty document"`` (for ``None``): what a value is, for messages."""
+    if value is None:
+        return "an empty document"
+    name = type(value).__name__
+    return f"{'an' if name[0] in 'aeiou' else 'a'} {name}"
+
+
 class _Validator:
     def __init__(self, source: str, error: type[InputError]) -> None:
         self.source = source
@@ -170,8 +180,7 @@ class _Validator:
 
     def fail(self, path: str, value: Any, allowed: str) -> InputError:
         if not path:
-            got = "an empty document" if value is None else f"a {type(value).__name__}"
-            return self.error.file(self.source, f"expected {allowed}, got {got}")
+            return self.error.file(self.source, f"expected {allowed}, got {describe_type(value)}")
         return self.error.invalid(self.source, path, value, allowed)
 
     def check(self, value: Any, spec: Spec, path: str) -> None:
@@ -205,7 +214,7 @@ class _Validator:
             raise self.fail(path, value, spec.expected())
         names = list(spec.fields)
         for key in value:
-            if not isinstance(key, str) or key not in spec.fields:
+            if not spec.others and (not isinstance(key, str) or key not in spec.fields):
                 self.unknown(key, names, path)
         for name, f in spec.fields.items():
             if name in value:

@@ -104,13 +104,19 @@ class StrictLoader(yaml.SafeLoader):
 StrictLoader.add_constructor("tag:yaml.org,2002:int", StrictLoader.construct_yaml_int)
 
 
+BOM = "\ufeff"
+"""The byte-order mark a UTF-8 file may start with (not part of :attr:`YamlFile.text`)."""
+
+
 @dataclass(frozen=True)
 class YamlFile:
-    """A loaded YAML file: the parsed ``data``, the decoded ``text`` and the sha256 of the file's bytes."""
+    """A loaded YAML file: the parsed ``data``, the decoded ``text`` (without a byte-order mark), the sha256 of the
+    file's bytes, and whether it started with a UTF-8 byte-order mark (``bom``)."""
 
     data: Any
     text: str
     sha256: str
+    bom: bool = False
 
 
 def _describe(exc: yaml.YAMLError) -> str:
@@ -164,4 +170,4 @@ def load_yaml_file(path: str | Path, *, what: str, error: type[InputError] = Inp
     raw = read_input_bytes(path, what=what, error=error, source=source, missing_hint=missing_hint)
     text = decode_utf8(raw, source, what=what, error=error)
     data = parse_yaml(text, source, what=what, error=error)
-    return YamlFile(data=data, text=text, sha256=hashlib.sha256(raw).hexdigest())
+    return YamlFile(data=data, text=text, sha256=hashlib.sha256(raw).hexdigest(), bom=raw.startswith(codecs.BOM_UTF8))

@@ -36,6 +36,7 @@ from ur3hanoi.labfile.read import (
     LabFile,
     RecordedTable,
     Slot,
+    lab_key,
     parse_q,
     read_lab_file,
     read_recorded_table,
@@ -43,22 +44,39 @@ from ur3hanoi.labfile.read import (
     recorded_table_of,
     table_of,
 )
-from ur3hanoi.labfile.write import format_q, format_xy, splice_yaml, write_table
+from ur3hanoi.labfile.visits import entries_visited, entry_label, missing_entries, require_entries
+from ur3hanoi.labfile.write import (
+    ANGLE_DECIMALS,
+    FILE_HEADER,
+    format_number,
+    format_q,
+    format_xy,
+    splice_yaml,
+    write_table,
+)
 
 __all__ = [
+    "ANGLE_DECIMALS",
     "BLOCK_XY_KEY",
+    "FILE_HEADER",
     "LAB_FILE_SCHEMA",
     "TABLE_KEYS",
     "LabFile",
     "RecordedTable",
     "Slot",
+    "entries_visited",
+    "entry_label",
+    "format_number",
     "format_q",
     "format_xy",
+    "lab_key",
+    "missing_entries",
     "parse_q",
     "read_lab_file",
     "read_recorded_table",
     "read_table",
     "recorded_table_of",
+    "require_entries",
     "splice_yaml",
     "table_of",
     "write_table",
