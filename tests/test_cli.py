@@ -367,3 +367,81 @@ def test_solve_render_outputs_are_checked_before_simulating(tmp_path: Path,
 
 def _listing(directory: Path) -> list[str]:
     return sorted(p.name for p in directory.iterdir())
+
+
+# ------------------------------------------------------------------- the table readers agree (issue 17)
+
+
+class _FakeArm:
+    """Stands in for ``ur3hanoi.ros.client.RosArm``: ros-solve's own table loading and moves, no ROS; suction
+    holds a block whenever it is on. Every commanded pose must be six finite angles."""
+
+    def __init__(self, config: object, master_uri: str | None = None, log: object = None) -> None:
+        self.master_uri = "fake://"
+        self.commands_sent = 0
+        self.on = False
+
+    def connect(self) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+    def move(self, q: object, watch: object = None) -> None:
+        import numpy as np
+
+        assert np.shape(q) == (6,) and np.all(np.isfinite(q)), q
+        self.commands_sent += 1
+
+    def suction(self, on: bool) -> None:
+        self.on = on
+
+    def held(self) -> bool:
+        return self.on
+
+    def wait_until(self, predicate: object, timeout_s: float) -> bool:
+        return bool(predicate())  # type: ignore[operator]
+
+    def feedback_text(self) -> str:
+        return "DIGIN=1"
+
+
+def _table_case(tmp_path: Path, case: str) -> Path:
+    import numpy as np
+
+    q = np.array(yaml.safe_load(LAB_TABLE.read_text())["sim_pos"], dtype=float).tolist()
+    extra = ""
+    if case == "unvisited-null-tower":  # one block from tower 1 to 3 never visits tower 2
+        q[1] = None
+    elif case == "visited-entry-missing":
+        q[2][0][1] = None
+    elif case == "other-keys-anything":
+        extra = "home_pos: whatever\nreal_pos: old\nblock_xy_pos: [[1]]\n"
+    path = tmp_path / f"{case}.yaml"
+    path.write_text(extra + yaml.safe_dump({"sim_pos": q}))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("case", "accepted"),
+    [("complete", True), ("unvisited-null-tower", True), ("visited-entry-missing", False),
+     ("other-keys-anything", True)],
+)
+def test_solve_and_ros_solve_accept_and_refuse_the_same_tables(case: str, accepted: bool, tmp_path: Path,
+                                                               monkeypatch: pytest.MonkeyPatch,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    import ur3hanoi.ros.client
+
+    monkeypatch.setattr(ur3hanoi.ros.client, "RosArm", _FakeArm)
+    path = _table_case(tmp_path, case)
+    instance = ["--table", str(path), "--key", "sim_pos", "--start", "1", "--end", "3", "--blocks", "1"]
+    codes = {}
+    for command in ("solve", "ros-solve"):
+        codes[command] = main([command, *instance])
+        err = capsys.readouterr().err
+        if not accepted:
+            assert "1 table entry the solve needs is missing: tower 3 height 1 above (Q[2][0][1])" in \
+                _one_error_line(err)
+    assert codes == ({"solve": 0, "ros-solve": 0} if accepted else {"solve": 2, "ros-solve": 2})
+    # check-table reads the same key the same way: every table here is readable (missing entries are listed).
+    assert main(["check-table", str(path), "--key", "sim_pos", "--calibration", "lab_sim"]) == 0

@@ -525,3 +525,17 @@ def test_splice_keeps_every_byte_outside_the_key(keys: list[str], values: list[s
     after = yaml.safe_load(new)
     np.testing.assert_allclose(np.array(after["sim_pos"], dtype=float), _SPLICE_Q, rtol=0.0, atol=1e-10)
     assert {k: v for k, v in after.items() if k != "sim_pos"} == {k: v for k, v in before.items() if k != "sim_pos"}
+
+
+def test_for_solve_needs_the_visited_entries_only(tmp_path: Path) -> None:
+    # 3 towers x 2 heights; one block from tower 1 to 3 visits height 1 of towers 1 and 3 only.
+    full = f"- - [{ON_Q}, {ABOVE_Q}]\n  - [{ON_Q}, {ABOVE_Q}]\n"
+    path = tmp_path / "t.yaml"
+    path.write_text(f"real_pos:\n- - [{ON_Q}, {ABOVE_Q}]\n  - null\n- null\n{full}")
+    rec = read_recorded_table(path, "real_pos")
+    q = rec.for_solve(0, 2, 1)
+    np.testing.assert_array_equal(q[2, 0, 1], ABOVE_Q)
+    with pytest.raises(TableError, match=r"t.yaml:real_pos: 4 table entries the solve needs are missing: tower 1 "
+                                         r"height 2 on \(Q\[0\]\[1\]\[0\]\); tower 1 height 2 above .*; tower 2 "
+                                         r"height 1 above \(Q\[1\]\[0\]\[1\]\)$"):
+        rec.for_solve(0, 2, 2)

@@ -76,7 +76,7 @@ def lab_key(data: dict[Any, Any], key: str, source: str) -> Any:
         present = [k for k in data if isinstance(k, str)]
         near = suggest(key, present)
         hint = f"; is '{printable(near, 60)}' a misspelling of it?" if near is not None else ""
-        known = ", ".join(k for k in present if k in LAB_FILE_SCHEMA.fields) or "none"
+        known = ", ".join(k for k in present if k in TABLE_KEYS) or "none"
         raise TableError(f"{printable(source)}: key '{key}' not found (table keys present: {known}){hint}")
     value = data[key]
     validate_schema(value, LAB_FILE_SCHEMA.fields[key].spec, source, TableError, path=key)
