@@ -445,3 +445,28 @@ def test_solve_and_ros_solve_accept_and_refuse_the_same_tables(case: str, accept
     assert codes == ({"solve": 0, "ros-solve": 0} if accepted else {"solve": 2, "ros-solve": 2})
     # check-table reads the same key the same way: every table here is readable (missing entries are listed).
     assert main(["check-table", str(path), "--key", "sim_pos", "--calibration", "lab_sim"]) == 0
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        ("{tower: 1, height: 1, q:", "{tower: 1, height: 1, pose: on, q:",
+         "taught.yaml: field 'points[0].pose' = on (line 7) is ambiguous: YAML 1.1 reads on as the boolean true; for "
+         "the text write it in quotes (pose: \"on\"); expected one of on, above"),
+        ("{tower: 1, height: 3,", "{tower: 1, height: 010,", None),
+        ("{tower: 3, height: 1, q: [157.43,", "{tower: 3, height: 1, q: [1:30,",
+         "field 'points[2].q[0]' = 1:30 (line 9) is ambiguous: YAML 1.1 reads 1:30 as 90 (a base-60 number)"),
+    ],
+    ids=["pose-on", "octal-height", "sexagesimal-angle"],
+)
+def test_yaml11_readings_in_a_taught_file_exit_2_quoting_the_source(old: str, new: str, message: str | None,
+                                                                      tmp_path: Path,
+                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    taught = tmp_path / "taught.yaml"
+    taught.write_text((REPO / "ur3hanoi/stations/taught_example.yaml").read_text().replace(old, new, 1))
+    out = tmp_path / "station.yaml"
+    assert main(["calibrate", "--taught", str(taught), "--base", "lab_real", "-o", str(out)]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert (message or "field 'points[3].height' = 010 (line 10) is ambiguous: YAML 1.1 reads 010 as the octal "
+                       "number 8; write 10 or 8, whichever you mean, without the leading zero") in err
+    assert not out.exists()

@@ -18,6 +18,7 @@ from typing import Any
 
 from ur3hanoi.errors import MISSING, InputError, printable, quote
 from ur3hanoi.io.limits import MAX_LIST_ITEMS
+from ur3hanoi.io.yaml_loader import Yaml11Reading
 
 
 def _fmt(x: float) -> str:
@@ -183,7 +184,32 @@ class _Validator:
             return self.error.file(self.source, f"expected {allowed}, got {describe_type(value)}")
         return self.error.invalid(self.source, path, value, allowed)
 
+    def ambiguous(self, path: str, value: Yaml11Reading, spec: Spec) -> InputError:
+        """``010``, ``1:30``, ``on`` where the schema expects a number or a name: quote the source, say how to
+        write it."""
+        while isinstance(spec, Nullable):
+            spec = spec.item
+        said = f"YAML 1.1 reads {value.text} as {value.meaning}"
+        if isinstance(spec, Text | Choice):
+            leaf = path.rsplit(".", 1)[-1] if path and not path.endswith("]") else ""
+            how = f"{leaf}: \"{value.text}\"" if leaf else f"\"{value.text}\""
+            allowed = f"{said}; for the text write it in quotes ({how}); expected {spec.expected()}"
+        elif isinstance(spec, Number) and ":" in value.text:
+            allowed = f"{said}; write the number itself ({value.value}) if that is what you mean; expected " \
+                      f"{spec.expected()}"
+        elif isinstance(spec, Number) and not isinstance(value.value, bool):
+            decimal = int(value.text.replace("_", ""))
+            allowed = f"{said}; write {decimal} or {value.value}, whichever you mean, without the leading zero; " \
+                      f"expected {spec.expected()}"
+        else:
+            allowed = f"{said}; expected {spec.expected()}"
+        where = f"{printable(self.source)}: field '{printable(path, 60)}'" if path else printable(self.source)
+        return self.error(f"{where} = {printable(value.text, 60)} (line {value.line}) is ambiguous: {allowed}",
+                          source=self.source, field=path, value=value, allowed=allowed)
+
     def check(self, value: Any, spec: Spec, path: str) -> None:
+        if isinstance(value, Yaml11Reading):
+            raise self.ambiguous(path, value, spec)
         if isinstance(spec, Number):
             if not spec.accepts(value):
                 raise self.fail(path, value, spec.expected())
