@@ -261,8 +261,9 @@ real_pos: [[1, 2]]   # malformed, but not ours to touch
          "sim_pos:\n  - [junk]\n"),  # comments after the value's last line belong to what follows
         ("  sim_pos: 1\n  other: 2\n", "  sim_pos: 1\n"),
         ("{home_pos: 1, sim_pos: old}\n", "sim_pos: old"),
+        ("a: 1\n? sim_pos\n: old\nb: 2\n", "? sim_pos\n: old\n"),
     ],
-    ids=["student", "no-key-yet", "no-newline", "bom-crlf", "markers", "indented", "flow"],
+    ids=["student", "no-key-yet", "no-newline", "bom-crlf", "markers", "indented", "flow", "explicit-key"],
 )
 def test_writing_a_key_keeps_every_other_byte(lab_real: Station, tmp_path: Path, text: str, old_entry: str) -> None:
     out = tmp_path / "lab2_data.yaml"
@@ -525,6 +526,16 @@ def test_splice_keeps_every_byte_outside_the_key(keys: list[str], values: list[s
     after = yaml.safe_load(new)
     np.testing.assert_allclose(np.array(after["sim_pos"], dtype=float), _SPLICE_Q, rtol=0.0, atol=1e-10)
     assert {k: v for k, v in after.items() if k != "sim_pos"} == {k: v for k, v in before.items() if k != "sim_pos"}
+
+
+def test_a_key_whose_anchor_another_key_uses_is_not_replaced(lab_real: Station, tmp_path: Path) -> None:
+    # Replacing sim_pos would leave `backup: *q` pointing nowhere: refused in one line, the file untouched.
+    out = tmp_path / "lab2_data.yaml"
+    out.write_text("sim_pos: &q [1]\nbackup: *q\n")
+    with pytest.raises(TableError, match=r"lab2_data.yaml: cannot write 'sim_pos' in place \(not valid YAML: found "
+                                         r"undefined alias 'q' .*\); file left unchanged$"):
+        write_table(out, generate_table(lab_real), "sim_pos")
+    assert out.read_text() == "sim_pos: &q [1]\nbackup: *q\n"
 
 
 def test_for_solve_needs_the_visited_entries_only(tmp_path: Path) -> None:

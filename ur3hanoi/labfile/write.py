@@ -236,8 +236,9 @@ def splice_yaml(old_text: str, new_sections: Mapping[str, str], header_lines: Ma
             edits.append((e.start, e.end, f"{e.key}: {_flow((flow_values or {})[e.key])}"))
             continue
         start = _line_start(old_text, e.start)
-        indent = old_text[start:e.start]
-        if indent.strip():  # `? key` or another key on the same line: replace from the key on
+        before = old_text[start:e.start]
+        indent = before[:len(before) - len(before.lstrip(" "))]
+        if before.strip() not in ("", "?"):  # something else before the key on its line: replace from the key on
             start, indent = e.start, ""
         # The key's own provenance comment right above it goes with it.
         prov = _provenance_re(e.key)
@@ -344,9 +345,12 @@ def _check_read_back(text: str, old: LabFile, sections: Mapping[str, str], value
     try:
         new_data = parse_yaml(text, shown, what=WHAT, error=TableError)
     except TableError as exc:
-        raise refuse(str(exc)) from None
+        raise refuse(str(exc).removeprefix(f"{printable(shown)}: ")) from None
     if not isinstance(new_data, dict):
         raise refuse("the result is not a mapping")
+    added = [k for k in new_data if k not in old.data and k not in sections]
+    if added:
+        raise refuse(f"a key {printable(repr(added[0]), 60)} would appear")
     for k, v in old.data.items():
         if k not in sections and (k not in new_data or not _same(new_data[k], v)):
             raise refuse(f"key {printable(k, 60)!r} would change")
