@@ -45,6 +45,24 @@ def test_tables_writes_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
     assert "placo IK" in out.read_text()
 
 
+def test_tables_writes_into_a_students_own_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # Unknown keys, junk in the key being replaced, a malformed key not touched: all the student's, all kept.
+    out = tmp_path / "lab2_data.yaml"
+    mine = "# group 7\nhome_pos: [1, 2]\nextra_notes: {ok: yes}\nreal_pos: [[1]]   # not touched\n"
+    out.write_text(mine + "sim_pos: old\n")
+    assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(out)]) == 0, capsys.readouterr().err
+    text = out.read_text()
+    assert text.startswith(mine) and "sim_pos: old" not in text
+    assert main(["check-table", str(out), "--key", "sim_pos", "--calibration", "lab_sim"]) == 0
+    # Only a file whose top level is not a mapping is refused: one line, exit 2, the file untouched.
+    out.write_text("- home_pos\n- sim_pos\n")
+    capsys.readouterr()
+    assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(out)]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert "lab2_data.yaml: the top level is a list, not a mapping of keys" in err
+    assert out.read_text() == "- home_pos\n- sim_pos\n"
+
+
 def test_unreachable_grid_exits_2_with_one_line_and_writes_nothing(tmp_path: Path,
                                                                    capsys: pytest.CaptureFixture[str]) -> None:
     cal = _bad_calibration(tmp_path, tower_origins=[[0.25, -0.20, 0.0288], [0.25, -0.09, 0.0288],
@@ -349,3 +367,106 @@ def test_solve_render_outputs_are_checked_before_simulating(tmp_path: Path,
 
 def _listing(directory: Path) -> list[str]:
     return sorted(p.name for p in directory.iterdir())
+
+
+# ------------------------------------------------------------------- the table readers agree (issue 17)
+
+
+class _FakeArm:
+    """Stands in for ``ur3hanoi.ros.client.RosArm``: ros-solve's own table loading and moves, no ROS; suction
+    holds a block whenever it is on. Every commanded pose must be six finite angles."""
+
+    def __init__(self, config: object, master_uri: str | None = None, log: object = None) -> None:
+        self.master_uri = "fake://"
+        self.commands_sent = 0
+        self.on = False
+
+    def connect(self) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+    def move(self, q: object, watch: object = None) -> None:
+        import numpy as np
+
+        assert np.shape(q) == (6,) and np.all(np.isfinite(q)), q
+        self.commands_sent += 1
+
+    def suction(self, on: bool) -> None:
+        self.on = on
+
+    def held(self) -> bool:
+        return self.on
+
+    def wait_until(self, predicate: object, timeout_s: float) -> bool:
+        return bool(predicate())  # type: ignore[operator]
+
+    def feedback_text(self) -> str:
+        return "DIGIN=1"
+
+
+def _table_case(tmp_path: Path, case: str) -> Path:
+    import numpy as np
+
+    q = np.array(yaml.safe_load(LAB_TABLE.read_text())["sim_pos"], dtype=float).tolist()
+    extra = ""
+    if case == "unvisited-null-tower":  # one block from tower 1 to 3 never visits tower 2
+        q[1] = None
+    elif case == "visited-entry-missing":
+        q[2][0][1] = None
+    elif case == "other-keys-anything":
+        extra = "home_pos: whatever\nreal_pos: old\nblock_xy_pos: [[1]]\n"
+    path = tmp_path / f"{case}.yaml"
+    path.write_text(extra + yaml.safe_dump({"sim_pos": q}))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("case", "accepted"),
+    [("complete", True), ("unvisited-null-tower", True), ("visited-entry-missing", False),
+     ("other-keys-anything", True)],
+)
+def test_solve_and_ros_solve_accept_and_refuse_the_same_tables(case: str, accepted: bool, tmp_path: Path,
+                                                               monkeypatch: pytest.MonkeyPatch,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    import ur3hanoi.ros.client
+
+    monkeypatch.setattr(ur3hanoi.ros.client, "RosArm", _FakeArm)
+    path = _table_case(tmp_path, case)
+    instance = ["--table", str(path), "--key", "sim_pos", "--start", "1", "--end", "3", "--blocks", "1"]
+    codes = {}
+    for command in ("solve", "ros-solve"):
+        codes[command] = main([command, *instance])
+        err = capsys.readouterr().err
+        if not accepted:
+            assert "1 table entry the solve needs is missing: tower 3 height 1 above (Q[2][0][1])" in \
+                _one_error_line(err)
+    assert codes == ({"solve": 0, "ros-solve": 0} if accepted else {"solve": 2, "ros-solve": 2})
+    # check-table reads the same key the same way: every table here is readable (missing entries are listed).
+    assert main(["check-table", str(path), "--key", "sim_pos", "--calibration", "lab_sim"]) == 0
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        ("{tower: 1, height: 1, q:", "{tower: 1, height: 1, pose: on, q:",
+         "taught.yaml: field 'points[0].pose' = on (line 7) is ambiguous: YAML 1.1 reads on as the boolean true; for "
+         "the text write it in quotes (pose: \"on\"); expected one of on, above"),
+        ("{tower: 1, height: 3,", "{tower: 1, height: 010,", None),
+        ("{tower: 3, height: 1, q: [157.43,", "{tower: 3, height: 1, q: [1:30,",
+         "field 'points[2].q[0]' = 1:30 (line 9) is ambiguous: YAML 1.1 reads 1:30 as 90 (a base-60 number)"),
+    ],
+    ids=["pose-on", "octal-height", "sexagesimal-angle"],
+)
+def test_yaml11_readings_in_a_taught_file_exit_2_quoting_the_source(old: str, new: str, message: str | None,
+                                                                      tmp_path: Path,
+                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    taught = tmp_path / "taught.yaml"
+    taught.write_text((REPO / "ur3hanoi/stations/taught_example.yaml").read_text().replace(old, new, 1))
+    out = tmp_path / "station.yaml"
+    assert main(["calibrate", "--taught", str(taught), "--base", "lab_real", "-o", str(out)]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert (message or "field 'points[3].height' = 010 (line 10) is ambiguous: YAML 1.1 reads 010 as the octal "
+                       "number 8; write 10 or 8, whichever you mean, without the leading zero") in err
+    assert not out.exists()

@@ -10,7 +10,8 @@ import pytest
 
 from ur3hanoi.errors import CalibrationError, InputError
 from ur3hanoi.io.limits import MAX_ALIASES, MAX_DEPTH, MAX_INT_DIGITS, MAX_NODES
-from ur3hanoi.io.yaml_loader import load_yaml_file, parse_yaml
+from ur3hanoi.io.schema import Choice, Field, ListOf, Nullable, Number, Record, Text, validate
+from ur3hanoi.io.yaml_loader import Yaml11Reading, load_yaml_file, parse_yaml
 
 
 def _laughs(levels: int) -> str:
@@ -93,3 +94,74 @@ def test_empty_file_is_none(tmp_path: Path) -> None:
     path = tmp_path / "f.yaml"
     path.write_text("# only a comment\n")
     assert load_yaml_file(path, what="test file").data is None
+
+
+# ------------------------------------------------------------------ YAML 1.1 readings that change a value
+
+
+@pytest.mark.parametrize(
+    ("text", "value", "meaning"),
+    [
+        ("010", 8, "the octal number 8"),
+        ("-0_17", -15, "the octal number -15"),
+        ("1:30", 90, "90 (a base-60 number)"),
+        ("1:30.5", 90.5, "90.5 (a base-60 number)"),
+        ("on", True, "the boolean true"),
+        ("Off", False, "the boolean false"),
+        ("YES", True, "the boolean true"),
+        ("no", False, "the boolean false"),
+    ],
+)
+def test_ambiguous_yaml11_scalars_keep_their_source_text(text: str, value: object, meaning: str) -> None:
+    got = parse_yaml(f"a: {text}\nb: [1, {text}]\n", "f.yaml")
+    for item in (got["a"], got["b"][1]):
+        assert isinstance(item, Yaml11Reading)
+        assert (item.text, item.value, item.meaning) == (text, value, meaning)
+        assert repr(item) == text
+    assert got["a"].line == 1 and got["b"][1].line == 2
+
+
+@pytest.mark.parametrize(
+    ("text", "value"),
+    [("'010'", "010"), ('"on"', "on"), ("10", 10), ("0", 0), ("0x10", 16), ("true", True), ("false", False),
+     ("0.5", 0.5), ("007.5", 7.5), ("-1", -1), ("1_000", 1000), ("07", 7), ("00", 0), ("'1:30'", "1:30"), ("y", "y")],
+)
+def test_unambiguous_scalars_load_as_before(text: str, value: object) -> None:
+    got = parse_yaml(f"a: {text}\n", "f.yaml")["a"]
+    assert got == value and type(got) is type(value)
+
+
+_SCHEMA = Record({"n": Field(Number(0, 100, integer=True)), "x": Field(Number(), required=False),
+                  "pose": Field(Choice(("on", "above")), required=False),
+                  "name": Field(Nullable(Text()), required=False), "q": Field(ListOf(Number()), required=False)})
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("n: 010", "field 'n' = 010 (line 1) is ambiguous: YAML 1.1 reads 010 as the octal number 8; write 10 or 8, "
+                   "whichever you mean, without the leading zero; expected an integer in [0, 100]"),
+        ("n: 1:30", "field 'n' = 1:30 (line 1) is ambiguous: YAML 1.1 reads 1:30 as 90 (a base-60 number); write the "
+                    "number itself (90) if that is what you mean"),
+        ("n: 5\nx: 1:30.5", "field 'x' = 1:30.5 (line 2) is ambiguous: YAML 1.1 reads 1:30.5 as 90.5"),
+        ("n: on", "field 'n' = on (line 1) is ambiguous: YAML 1.1 reads on as the boolean true; expected an integer"),
+        ("n: 5\npose: on", "field 'pose' = on (line 2) is ambiguous: YAML 1.1 reads on as the boolean true; for the "
+                           "text write it in quotes (pose: \"on\"); expected one of on, above"),
+        ("n: 5\nname: 010", "field 'name' = 010 (line 2) is ambiguous: YAML 1.1 reads 010 as the octal number 8; for "
+                            "the text write it in quotes (name: \"010\")"),
+        ("n: 5\nname: no", "(name: \"no\")"),
+        ("n: 5\nq: [1, off]", "field 'q[1]' = off (line 2) is ambiguous: YAML 1.1 reads off as the boolean false"),
+    ],
+)
+def test_ambiguous_scalars_are_refused_where_a_number_or_a_name_is_expected(text: str, message: str) -> None:
+    with pytest.raises(InputError) as info:
+        validate(parse_yaml(text + "\n", "f.yaml"), _SCHEMA, "f.yaml")
+    assert str(info.value).startswith("f.yaml: ") and message in str(info.value) and "\n" not in str(info.value)
+
+
+def test_ambiguous_scalars_are_kept_where_anything_goes() -> None:
+    # A key open to its owner (a student's own keys in a lab file) holds whatever it holds, unchanged.
+    data = parse_yaml("n: 5\nmine: {door: 010, lights: on}\n", "f.yaml")
+    validate(data, Record({"n": Field(Number())}, others=True), "f.yaml")
+    assert data["mine"] == {"door": Yaml11Reading("010", 8, "the octal number 8", 2),
+                            "lights": Yaml11Reading("on", True, "the boolean true", 2)}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import re
 import shutil
 from pathlib import Path
 from typing import Any
@@ -11,12 +12,25 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from ur3hanoi.cli import main
 from ur3hanoi.errors import OutputError, TableError
 from ur3hanoi.grid import T_world_tcp
 from ur3hanoi.ik import pose_errors
-from ur3hanoi.labfile import parse_q, read_lab_file, read_recorded_table, read_table, write_table
+from ur3hanoi.labfile import (
+    ANGLE_DECIMALS,
+    FILE_HEADER,
+    format_number,
+    format_q,
+    parse_q,
+    read_lab_file,
+    read_recorded_table,
+    read_table,
+    splice_yaml,
+    write_table,
+)
 from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import Station
 from ur3hanoi.waypoints import generate_table
@@ -38,13 +52,43 @@ def _regenerate(out: Path) -> None:
     assert main(["tables", "lab_real", "--key", "real_pos", "-o", str(out)]) == 0
 
 
+_NUMBER = re.compile(r"-?\d+\.\d+")
+ANGLE_TOL = 1e-9  # [rad] and [m]: the IK's own accuracy; last-bit noise between CPUs is about 1e-15
+
+
+def assert_same_tables(text: str, expected: str) -> None:
+    """Two lab files hold the same tables: numbers within ANGLE_TOL, everything else (keys, comments, layout,
+    provenance) the same text."""
+    assert _NUMBER.sub("#", text) == _NUMBER.sub("#", expected)
+    got, want = yaml.safe_load(text), yaml.safe_load(expected)
+    assert got.keys() == want.keys()
+    for key in want:
+        np.testing.assert_allclose(np.array(got[key], dtype=float), np.array(want[key], dtype=float),
+                                   rtol=0.0, atol=ANGLE_TOL, err_msg=f"{key}: run `make tables`")
+
+
 def test_shipped_table_is_not_stale(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(REPO)
     fresh = tmp_path / "lab2_data.yaml"
     _regenerate(fresh)
-    assert fresh.read_bytes() == (REPO / "tables/lab2_data.yaml").read_bytes(), (
-        "tables/lab2_data.yaml is stale: run `make tables`"
-    )
+    assert_same_tables(fresh.read_text(), (REPO / "tables/lab2_data.yaml").read_text())
+
+
+def test_last_bit_noise_does_not_show_in_the_file(lab_sim: Station) -> None:
+    # Another CPU computes the same IK up to a few ulps (1.8e-15 rad seen between two machines): the file's text
+    # must not change. Seeded angles, so no value sits on a rounding boundary by chance on any machine.
+    rng = np.random.default_rng(17)
+    q = rng.uniform(-2 * np.pi, 2 * np.pi, size=(3, 3, 2, 6))
+    text = format_q(q, "sim_pos")
+    for ulps in (1, 4, -4):
+        noisy = q.copy()
+        for _ in range(abs(ulps)):
+            noisy = np.nextafter(noisy, np.inf if ulps > 0 else -np.inf)
+        assert format_q(noisy, "sim_pos") == text
+    back = np.array(yaml.safe_load(text)["sim_pos"], dtype=float)
+    np.testing.assert_allclose(back, q, rtol=0.0, atol=0.5 * 10.0 ** -ANGLE_DECIMALS)
+    assert format_number(-1e-17) == "0.0" and format_number(2.0) == "2.0" and format_number(-0.5) == "-0.5"
+    assert all(isinstance(yaml.safe_load(format_number(x)), float) for x in (0.0, -0.0, 1e-12, 3.0, -6.2831853))
 
 
 def test_course_format_and_order(lab_sim: Station, tmp_path: Path) -> None:
@@ -167,18 +211,102 @@ def test_parse_q_errors_name_the_entry(value: object, match: str) -> None:
     [
         ("sim_pos: []\n\"sim_pos\": []\n", r"duplicate key 'sim_pos' \(first given on line 1\) \(line 2"),
         ("sim_pso: [[[[0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0]]]]\n",
-         r"field 'sim_pso' is unknown: did you mean 'sim_pos'\?"),
-        ("notes: {station: 4}\n", r"field 'notes' is unknown: expected one of sim_pos, real_pos, block_xy_pos"),
-        ("- 1\n", r"expected a mapping with keys sim_pos, real_pos, block_xy_pos, got a list"),
-        ("block_xy_pos: [[[0.2, .inf]]]\n", r"field 'block_xy_pos\[0\]\[0\]\[1\]' = inf is invalid"),
+         r"key 'sim_pos' not found \(table keys present: none\); is 'sim_pso' a misspelling of it\?"),
+        ("- 1\n", r"lab2_data.yaml: the top level is a list, not a mapping of keys \(sim_pos, real_pos, block_xy_pos, "
+                  r"or your own\)"),
+        ("sim_pos: [[[[0.2, .inf, 0, 0, 0, 0]]]]\n", r"field 'sim_pos\[0\]\[0\]\[0\]\[1\]' = inf is invalid"),
+        ("sim_pos: old\n", r"field 'sim_pos' = 'old' is invalid: expected a list of 1..10 towers"),
     ],
-    ids=["duplicate", "typo", "unknown", "not-a-mapping", "inf"],
+    ids=["duplicate", "typo", "not-a-mapping", "inf", "junk"],
 )
 def test_strict_lab_file(tmp_path: Path, text: str, match: str) -> None:
     path = tmp_path / "lab2_data.yaml"
     path.write_text(text)
-    with pytest.raises(TableError, match=match):
-        read_lab_file(path)
+    with pytest.raises(TableError, match=match) as info:
+        read_recorded_table(path, "sim_pos")
+    assert "\n" not in str(info.value)
+
+
+def test_readers_check_only_the_key_they_read(tmp_path: Path) -> None:
+    # A student's own keys, junk in real_pos and a malformed block_xy_pos do not stop anyone reading sim_pos.
+    path = tmp_path / "lab2_data.yaml"
+    path.write_text(f"home_pos: [1, 2, 3]\nextra_notes: {{station: 4, ok: yes}}\nreal_pos: old\n"
+                    f"block_xy_pos: [[1]]\nsim_pos:\n- - [{ON_Q}, {ABOVE_Q}]\n")
+    np.testing.assert_array_equal(read_table(path, "sim_pos"), [[[ON_Q, ABOVE_Q]]])
+    with pytest.raises(TableError, match=r"field 'real_pos' = 'old' is invalid"):
+        read_table(path, "real_pos")
+
+
+STUDENT_FILE = """\
+# Lab 2, group 7: our own notes stay ours
+home_pos: [2.0944, -1.5708, 1.5708, -1.5708, -1.5708, 0.0]   # radians(120, -90, 90, -90, -90, 0)
+
+sim_pos: old   # to be regenerated
+# notes about the station
+extra_notes: |
+  suction cup replaced on 2025-10-02
+  keep: the text exactly
+real_pos: [[1, 2]]   # malformed, but not ours to touch
+"""
+
+
+@pytest.mark.parametrize(
+    ("text", "old_entry"),
+    [
+        (STUDENT_FILE, "sim_pos: old   # to be regenerated\n"),
+        (STUDENT_FILE.replace("sim_pos: old   # to be regenerated\n", ""), ""),
+        ("home_pos: 1", ""),
+        ("\ufeff# a BOM and CRLF line ends\r\nsim_pos:\r\n- 1\r\nb: 2\r\n", "sim_pos:\r\n- 1\r\n"),
+        ("---\nsim_pos:\n  - [junk]\n  # an indented comment about the junk\n# next key\nhome: 1\n...\n",
+         "sim_pos:\n  - [junk]\n"),  # comments after the value's last line belong to what follows
+        ("  sim_pos: 1\n  other: 2\n", "  sim_pos: 1\n"),
+        ("{home_pos: 1, sim_pos: old}\n", "sim_pos: old"),
+        ("a: 1\n? sim_pos\n: old\nb: 2\n", "? sim_pos\n: old\n"),
+    ],
+    ids=["student", "no-key-yet", "no-newline", "bom-crlf", "markers", "indented", "flow", "explicit-key"],
+)
+def test_writing_a_key_keeps_every_other_byte(lab_real: Station, tmp_path: Path, text: str, old_entry: str) -> None:
+    out = tmp_path / "lab2_data.yaml"
+    out.write_bytes(text.encode("utf-8"))
+    before = yaml.safe_load(text.lstrip("\ufeff"))
+    table = generate_table(lab_real)
+    write_table(out, table, "sim_pos")
+    raw = out.read_bytes()
+    new = raw.decode("utf-8")
+    assert raw.startswith(b"\xef\xbb\xbf") == text.startswith("\ufeff")
+    # The new entry (its provenance line and the generated block) is one contiguous piece, where the old one was
+    # or after the last key; taking it out leaves the old file without its old entry, byte for byte.
+    if "{" in text:
+        ours = "sim_pos: " + re.search(r"\[\[\[\[.*?\]\]\]\]", new).group(0)  # type: ignore[union-attr]
+    else:
+        nl = "\r\n" if "\r\n" in text else "\n"
+        indent = text[:len(text) - len(text.lstrip(" "))]
+        start = new.index(f"{indent}# ur3hanoi ")
+        end = new.index("# tower 3 height 3 above", start) + len("# tower 3 height 3 above") + len(nl)
+        ours = new[start:end]
+        block = "".join(indent + line + nl for line in format_q(table.q, "sim_pos").splitlines())
+        assert ours.endswith(block) and ours.count(nl) == block.count(nl) + 1
+    rest = new.replace(ours, "", 1)
+    missing_nl = "" if text.endswith("\n") or text.endswith("}\n") else "\n"
+    assert rest == (text.replace(old_entry, "", 1) if old_entry else text + missing_nl)
+    data = yaml.safe_load(new.lstrip("\ufeff"))
+    np.testing.assert_allclose(np.array(data["sim_pos"], dtype=float), table.q, rtol=0.0, atol=1e-9)
+    assert {k: v for k, v in data.items() if k != "sim_pos"} == {k: v for k, v in (before or {}).items()
+                                                                 if k != "sim_pos"}
+    # Writing it again changes nothing.
+    write_table(out, table, "sim_pos")
+    assert out.read_bytes() == raw
+
+
+@pytest.mark.parametrize("text", ["- 1\n- 2\n", "just a line of text\n", "42\n", "a: [unclosed\n"])
+def test_a_file_that_is_not_a_mapping_is_refused_untouched(lab_real: Station, tmp_path: Path, text: str) -> None:
+    out = tmp_path / "lab2_data.yaml"
+    out.write_text(text)
+    with pytest.raises(TableError, match=r"lab2_data.yaml: (the top level is an? \w+, not a mapping|not valid YAML)"
+                       ) as info:
+        write_table(out, generate_table(lab_real), "real_pos")
+    assert "\n" not in str(info.value)
+    assert out.read_text() == text and _listing(tmp_path) == ["lab2_data.yaml"]
 
 
 def test_existing_invalid_file_is_not_updated(lab_sim: Station, tmp_path: Path) -> None:
@@ -194,7 +322,7 @@ def test_quoted_key_is_replaced_not_duplicated(lab_real: Station, tmp_path: Path
     out = tmp_path / "lab2_data.yaml"
     out.write_text('"real_pos": [[[[0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0]]]]\n')
     write_table(out, generate_table(lab_real), "real_pos")
-    np.testing.assert_array_equal(read_table(out, "real_pos"), generate_table(lab_real).q)
+    np.testing.assert_allclose(read_table(out, "real_pos"), generate_table(lab_real).q, rtol=0.0, atol=ANGLE_TOL)
     assert out.read_text().count("real_pos:") == 1
 
 
@@ -222,7 +350,8 @@ def test_symlinked_output_is_written_through(lab_real: Station, tmp_path: Path) 
     link.symlink_to(target)
     write_table(link, generate_table(lab_real), "real_pos")
     assert link.is_symlink() and target.is_file()
-    np.testing.assert_array_equal(read_table(target, "real_pos"), generate_table(lab_real).q)
+    np.testing.assert_allclose(read_table(target, "real_pos"), generate_table(lab_real).q, rtol=0.0,
+                               atol=ANGLE_TOL)
     assert sorted(p.name for p in target.parent.iterdir()) == ["lab2_data.yaml"]
 
 
@@ -356,3 +485,68 @@ def test_writing_a_key_keeps_a_partial_hand_recorded_key(lab_sim: Station, tmp_p
     write_table(out, generate_table(lab_sim), "sim_pos")
     assert hand in out.read_text()
     assert read_recorded_table(out, "real_pos").missing == ((0, 0, 1), (0, 1, 0), (0, 1, 1), (1, 1, 1))
+
+
+# ------------------------------------------------------------------------------ splicing into any student file
+
+_VALUES = [" 1", " old", " [1, 2]", " {a: yes, b: [x]}", "\n- 1\n- [2, 3]", "\n  - 1\n  - 2", " |\n  text\n  more",
+           "", " 'quoted: # not a comment'", " &a{i} [1.5]", "\n  nested: 1\n  deeper:\n    - x"]
+_FILLER = ["", "\n", "# a comment\n", "\n# about the next key\n", "   # indented comment\n"]
+_SPLICE_Q = np.arange(2 * 2 * 2 * 6, dtype=float).reshape(2, 2, 2, 6) / 7.0
+
+
+@settings(max_examples=100, deadline=None, derandomize=True)
+@given(keys=st.lists(st.sampled_from(["home_pos", "extra_notes", "real_pos", "notes", "sim_pos", "block_xy_pos"]),
+                     unique=True, max_size=5),
+       values=st.lists(st.sampled_from(_VALUES), min_size=5, max_size=5),
+       fillers=st.lists(st.sampled_from(_FILLER), min_size=6, max_size=6),
+       comments=st.lists(st.booleans(), min_size=5, max_size=5))
+def test_splice_keeps_every_byte_outside_the_key(keys: list[str], values: list[str], fillers: list[str],
+                                                 comments: list[bool]) -> None:
+    parts, old_entry = [fillers[5]], None
+    for i, key in enumerate(keys):
+        value = values[i].replace("{i}", str(i))
+        comment = "  # my comment" if comments[i] and "\n" not in value and "|" not in value else ""
+        entry = f"{key}:{value}{comment}\n"
+        if key == "sim_pos":
+            old_entry = len(parts)
+        parts += [entry, fillers[i]]
+    old = "".join(parts)
+    before = yaml.safe_load(old) or {}
+    block = format_q(_SPLICE_Q, "sim_pos")
+    header = "# ur3hanoi 0.0: sim_pos generated from test"
+    new = splice_yaml(old, {"sim_pos": block}, {"sim_pos": header})
+    ours = header + "\n" + block
+    assert new.count(ours) == 1
+    expected = "".join(parts[:old_entry] + parts[old_entry + 1:]) if old_entry is not None else old
+    rest = new.replace(ours, "", 1)
+    if not keys:
+        rest = rest.replace(FILE_HEADER, "", 1) if not old.strip() else rest
+    assert rest == expected
+    after = yaml.safe_load(new)
+    np.testing.assert_allclose(np.array(after["sim_pos"], dtype=float), _SPLICE_Q, rtol=0.0, atol=1e-10)
+    assert {k: v for k, v in after.items() if k != "sim_pos"} == {k: v for k, v in before.items() if k != "sim_pos"}
+
+
+def test_a_key_whose_anchor_another_key_uses_is_not_replaced(lab_real: Station, tmp_path: Path) -> None:
+    # Replacing sim_pos would leave `backup: *q` pointing nowhere: refused in one line, the file untouched.
+    out = tmp_path / "lab2_data.yaml"
+    out.write_text("sim_pos: &q [1]\nbackup: *q\n")
+    with pytest.raises(TableError, match=r"lab2_data.yaml: cannot write 'sim_pos' in place \(not valid YAML: found "
+                                         r"undefined alias 'q' .*\); file left unchanged$"):
+        write_table(out, generate_table(lab_real), "sim_pos")
+    assert out.read_text() == "sim_pos: &q [1]\nbackup: *q\n"
+
+
+def test_for_solve_needs_the_visited_entries_only(tmp_path: Path) -> None:
+    # 3 towers x 2 heights; one block from tower 1 to 3 visits height 1 of towers 1 and 3 only.
+    full = f"- - [{ON_Q}, {ABOVE_Q}]\n  - [{ON_Q}, {ABOVE_Q}]\n"
+    path = tmp_path / "t.yaml"
+    path.write_text(f"real_pos:\n- - [{ON_Q}, {ABOVE_Q}]\n  - null\n- null\n{full}")
+    rec = read_recorded_table(path, "real_pos")
+    q = rec.for_solve(0, 2, 1)
+    np.testing.assert_array_equal(q[2, 0, 1], ABOVE_Q)
+    with pytest.raises(TableError, match=r"t.yaml:real_pos: 4 table entries the solve needs are missing: tower 1 "
+                                         r"height 2 on \(Q\[0\]\[1\]\[0\]\); tower 1 height 2 above .*; tower 2 "
+                                         r"height 1 above \(Q\[1\]\[0\]\[1\]\)$"):
+        rec.for_solve(0, 2, 2)

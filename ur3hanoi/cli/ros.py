@@ -136,7 +136,7 @@ def _run_solve(args: argparse.Namespace) -> int:
 
     from ur3hanoi.errors import SuctionFaultError
     from ur3hanoi.hanoi import validate_instance
-    from ur3hanoi.labfile import read_table
+    from ur3hanoi.labfile import read_recorded_table
     from ur3hanoi.robot import Q_HOME_LAB
     from ur3hanoi.ros.client import ArmConfig, RosArm
     from ur3hanoi.ros.solve import LabSolveConfig, run_lab_solve
@@ -147,11 +147,12 @@ def _run_solve(args: argparse.Namespace) -> int:
         raise UsageError("--key is only used with --table (the table is generated from --calibration otherwise)")
     station = None if args.table is not None and args.calibration is None else \
         load_station(args.calibration or DEFAULT_CALIBRATION)
-    if args.table is not None:
-        Q = read_table(args.table, args.key or "sim_pos")
+    if args.table is not None:  # the reader and the entry rule of `solve --table` (entries never visited may miss)
+        recorded = read_recorded_table(args.table, args.key or "sim_pos")
+        Q = recorded.q
     else:
         assert station is not None
-        Q = generate_table(station).q
+        recorded, Q = None, generate_table(station).q
     home = np.array(Q_HOME_LAB if station is None else station.q_home, dtype=float)
     n_towers, n_heights = Q.shape[0], Q.shape[1]
     n_blocks = n_heights if args.blocks is None else args.blocks
@@ -164,6 +165,8 @@ def _run_solve(args: argparse.Namespace) -> int:
     else:
         start, end = args.start - 1, args.end - 1
     validate_instance(n_blocks, start, end, n_towers, n_heights)
+    if recorded is not None:
+        Q = recorded.for_solve(start, end, n_blocks)
 
     say = (lambda s: print(s, file=sys.stderr, flush=True)) if args.json else (lambda s: print(s, flush=True))
     arm = RosArm(ArmConfig(v=args.v, a=args.a), master_uri=args.master, log=say)

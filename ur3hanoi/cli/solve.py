@@ -220,21 +220,23 @@ def run(args: argparse.Namespace) -> int:
     cal = _table_calibration(args)
     inputs = [input_file(cal)]
     station = load_station(cal)
-    table = None
+    table = recorded = None
     if args.table is not None:
         from ur3hanoi.labfile import read_recorded_table
         from ur3hanoi.plan import check_table_shape
 
         inputs.append(Path(args.table))
-        # Entries may be missing (null, or no "above" list) as students record them: NaN rows, and the plan
-        # names every missing entry the solve would visit.
-        table = read_recorded_table(args.table, args.key).q
-        check_table_shape(table, station, f"{args.table}:{args.key}")
+        # Entries may be missing (null, or no "above" list) as students record them: the entries the solve visits
+        # must be there (RecordedTable.for_solve, the rule ros-solve applies too), the others may be missing.
+        recorded = read_recorded_table(args.table, args.key)
+        check_table_shape(recorded.q, station, f"{args.table}:{args.key}")
     n_towers = station.n_towers
     n_blocks = station.n_heights if args.blocks is None else args.blocks
     check_blocks(n_blocks, station.n_heights, given=args.blocks is not None)
     start, end = _towers(args, n_towers)
     validate_instance(n_blocks, start, end, n_towers, station.n_heights)
+    if recorded is not None:
+        table = recorded.for_solve(start, end, n_blocks)
     check_faults(args.remove_block, args.drop_during_move, n_blocks)
     plan_config = PlanConfig(speed=args.speed)
     check_plan_size(n_blocks, args.speed, plan_config.dwell_s, plan_config.rate_hz)

@@ -18,6 +18,7 @@ from typing import Any
 
 from ur3hanoi.errors import MISSING, InputError, printable, quote
 from ur3hanoi.io.limits import MAX_LIST_ITEMS
+from ur3hanoi.io.yaml_loader import Yaml11Reading
 
 
 def _fmt(x: float) -> str:
@@ -134,9 +135,11 @@ class Field:
 
 @dataclass(frozen=True)
 class Record:
-    """A mapping with exactly the given keys (optional ones may be absent); any other key is an error."""
+    """A mapping with the given keys (optional ones may be absent). Any other key is an error, unless ``others``:
+    then other keys are the file owner's and hold anything."""
 
     fields: Mapping[str, Field] = field(default_factory=dict)
+    others: bool = False
 
     def expected(self) -> str:
         return f"a mapping with keys {', '.join(self.fields)}"
@@ -163,6 +166,14 @@ def suggest(key: object, valid: list[str]) -> str | None:
     return best
 
 
+def describe_type(value: Any) -> str:
+    """``"a list"``, ``"a str"``, ``"an empty document"`` (for ``None``): what a value is, for messages."""
+    if value is None:
+        return "an empty document"
+    name = type(value).__name__
+    return f"{'an' if name[0] in 'aeiou' else 'a'} {name}"
+
+
 class _Validator:
     def __init__(self, source: str, error: type[InputError]) -> None:
         self.source = source
@@ -170,11 +181,35 @@ class _Validator:
 
     def fail(self, path: str, value: Any, allowed: str) -> InputError:
         if not path:
-            got = "an empty document" if value is None else f"a {type(value).__name__}"
-            return self.error.file(self.source, f"expected {allowed}, got {got}")
+            return self.error.file(self.source, f"expected {allowed}, got {describe_type(value)}")
         return self.error.invalid(self.source, path, value, allowed)
 
+    def ambiguous(self, path: str, value: Yaml11Reading, spec: Spec) -> InputError:
+        """``010``, ``1:30``, ``on`` where the schema expects a number or a name: quote the source, say how to
+        write it."""
+        while isinstance(spec, Nullable):
+            spec = spec.item
+        said = f"YAML 1.1 reads {value.text} as {value.meaning}"
+        if isinstance(spec, Text | Choice):
+            leaf = path.rsplit(".", 1)[-1] if path and not path.endswith("]") else ""
+            how = f"{leaf}: \"{value.text}\"" if leaf else f"\"{value.text}\""
+            allowed = f"{said}; for the text write it in quotes ({how}); expected {spec.expected()}"
+        elif isinstance(spec, Number) and ":" in value.text:
+            allowed = f"{said}; write the number itself ({value.value}) if that is what you mean; expected " \
+                      f"{spec.expected()}"
+        elif isinstance(spec, Number) and not isinstance(value.value, bool):
+            decimal = int(value.text.replace("_", ""))
+            allowed = f"{said}; write {decimal} or {value.value}, whichever you mean, without the leading zero; " \
+                      f"expected {spec.expected()}"
+        else:
+            allowed = f"{said}; expected {spec.expected()}"
+        where = f"{printable(self.source)}: field '{printable(path, 60)}'" if path else printable(self.source)
+        return self.error(f"{where} = {printable(value.text, 60)} (line {value.line}) is ambiguous: {allowed}",
+                          source=self.source, field=path, value=value, allowed=allowed)
+
     def check(self, value: Any, spec: Spec, path: str) -> None:
+        if isinstance(value, Yaml11Reading):
+            raise self.ambiguous(path, value, spec)
         if isinstance(spec, Number):
             if not spec.accepts(value):
                 raise self.fail(path, value, spec.expected())
@@ -205,7 +240,7 @@ class _Validator:
             raise self.fail(path, value, spec.expected())
         names = list(spec.fields)
         for key in value:
-            if not isinstance(key, str) or key not in spec.fields:
+            if not spec.others and (not isinstance(key, str) or key not in spec.fields):
                 self.unknown(key, names, path)
         for name, f in spec.fields.items():
             if name in value:

@@ -11,6 +11,13 @@ On top of PyYAML's ``SafeLoader`` (no Python objects) it refuses, with one line 
 - integers longer than :data:`~ur3hanoi.io.limits.MAX_INT_DIGITS` digits;
 - anything but UTF-8 text (UTF-16 or Latin-1 files), and files that are not regular or too large
   (see :mod:`ur3hanoi.io.reading`).
+
+YAML 1.1 (what PyYAML implements) reads a few plain scalars as something other than what they look like:
+``010`` is the octal number 8, ``1:30`` is 90 (base 60), and unquoted ``on``/``off``/``yes``/``no`` are
+booleans. The loader keeps such a scalar as a :class:`Yaml11Reading` (its source text, the YAML 1.1 value and
+what that value means) instead of the silent value, and the schema validator (:mod:`ur3hanoi.io.schema`) refuses
+it wherever a number or a name is expected, quoting the source text and how to write it (``pose: "on"``). Where a
+file holds free-form data (a student's own keys in a lab table), it stays as it is.
 """
 
 from __future__ import annotations
@@ -30,6 +37,31 @@ from ur3hanoi.io.limits import MAX_ALIASES, MAX_DEPTH, MAX_INT_DIGITS, MAX_NODES
 from ur3hanoi.io.reading import read_input_bytes
 
 _MERGE_TAG = "tag:yaml.org,2002:merge"
+
+
+@dataclass(frozen=True)
+class Yaml11Reading:
+    """A plain scalar YAML 1.1 reads as something else than it looks: ``text`` as written, ``value`` the YAML 1.1
+    reading (8 for ``010``, 90 for ``1:30``, True for ``on``), ``meaning`` that reading in words, ``line``
+    1-based. Its ``repr`` is the source text, so messages quote what the file says."""
+
+    text: str
+    value: Any
+    meaning: str
+    line: int
+
+    def __repr__(self) -> str:
+        return self.text
+
+
+_YAML11_BOOLS = frozenset({"yes", "no", "on", "off"})
+
+
+def _octal(text: str) -> bool:
+    """``010``, ``-0_17``: an integer with a leading zero, read by YAML 1.1 as octal (``07`` reads as 7 either
+    way and is kept)."""
+    digits = text.lstrip("+-").replace("_", "")
+    return len(digits) > 1 and digits[0] == "0" and digits.isdigit()
 
 
 class YamlLimitError(yaml.MarkedYAMLError):
@@ -93,24 +125,48 @@ class StrictLoader(yaml.SafeLoader):
                 first[key] = key_node.start_mark
         return super().construct_mapping(node, deep=deep)
 
-    def construct_yaml_int(self, node: ScalarNode) -> int:
+    def construct_yaml_int(self, node: ScalarNode) -> int | Yaml11Reading:  # type: ignore[override]
         text = str(node.value)
         if sum(c.isalnum() for c in text) > MAX_INT_DIGITS:
             raise YamlLimitError(problem=f"integer longer than {MAX_INT_DIGITS} digits", problem_mark=node.start_mark)
         value: int = super().construct_yaml_int(node)
+        if node.style is None and _octal(text) and int(text.replace("_", ""), 10) != value:
+            return Yaml11Reading(text, value, f"the octal number {value}", node.start_mark.line + 1)
+        if node.style is None and ":" in text:
+            return Yaml11Reading(text, value, f"{value} (a base-60 number)", node.start_mark.line + 1)
+        return value
+
+    def construct_yaml_float(self, node: ScalarNode) -> float | Yaml11Reading:  # type: ignore[override]
+        value: float = super().construct_yaml_float(node)
+        if node.style is None and ":" in str(node.value):
+            return Yaml11Reading(str(node.value), value, f"{value:g} (a base-60 number)", node.start_mark.line + 1)
+        return value
+
+    def construct_yaml_bool(self, node: ScalarNode) -> bool | Yaml11Reading:  # type: ignore[override]
+        value: bool = super().construct_yaml_bool(node)
+        if node.style is None and str(node.value).lower() in _YAML11_BOOLS:
+            return Yaml11Reading(str(node.value), value, f"the boolean {str(value).lower()}", node.start_mark.line + 1)
         return value
 
 
 StrictLoader.add_constructor("tag:yaml.org,2002:int", StrictLoader.construct_yaml_int)
+StrictLoader.add_constructor("tag:yaml.org,2002:float", StrictLoader.construct_yaml_float)
+StrictLoader.add_constructor("tag:yaml.org,2002:bool", StrictLoader.construct_yaml_bool)
+
+
+BOM = "\ufeff"
+"""The byte-order mark a UTF-8 file may start with (not part of :attr:`YamlFile.text`)."""
 
 
 @dataclass(frozen=True)
 class YamlFile:
-    """A loaded YAML file: the parsed ``data``, the decoded ``text`` and the sha256 of the file's bytes."""
+    """A loaded YAML file: the parsed ``data``, the decoded ``text`` (without a byte-order mark), the sha256 of the
+    file's bytes, and whether it started with a UTF-8 byte-order mark (``bom``)."""
 
     data: Any
     text: str
     sha256: str
+    bom: bool = False
 
 
 def _describe(exc: yaml.YAMLError) -> str:
@@ -164,4 +220,4 @@ def load_yaml_file(path: str | Path, *, what: str, error: type[InputError] = Inp
     raw = read_input_bytes(path, what=what, error=error, source=source, missing_hint=missing_hint)
     text = decode_utf8(raw, source, what=what, error=error)
     data = parse_yaml(text, source, what=what, error=error)
-    return YamlFile(data=data, text=text, sha256=hashlib.sha256(raw).hexdigest())
+    return YamlFile(data=data, text=text, sha256=hashlib.sha256(raw).hexdigest(), bom=raw.startswith(codecs.BOM_UTF8))

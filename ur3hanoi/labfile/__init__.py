@@ -1,11 +1,12 @@
-"""The lab's table file ``lab2_data.yaml``: strict reading, and in-place updates of one key.
+"""The lab's table file ``lab2_data.yaml``: reading one key strictly, and writing one key in place.
 
 File format (the course's): top-level keys ``sim_pos`` / ``real_pos``, each ``Q[tower][height][k]`` with six joint
 angles [rad] (controller convention), ``k = 0`` the contact ("on") pose and ``k = 1`` the pose above it; plus
-``block_xy_pos[tower][height] = [x, y]`` [m, world] for the flat simulator layout. Any other key, a key given twice,
-or a value of the wrong shape or range is refused (:data:`LAB_FILE_SCHEMA`). The list indices are 0-based, as the
-lab defines them; everything ur3hanoi shows people numbers towers and heights from 1 (``Q[0][2][1]`` is "tower 1
-height 3 above").
+``block_xy_pos[tower][height] = [x, y]`` [m, world] for the flat simulator layout. The file is the student's: any
+other key is theirs and may hold anything (:data:`LAB_FILE_SCHEMA` is open). A reader checks only the key it reads
+(:func:`lab_key`: shape, range, no key given twice); a malformed ``real_pos`` does not stop anyone reading
+``sim_pos``. The list indices are 0-based, as the lab defines them; everything ur3hanoi shows people numbers towers
+and heights from 1 (``Q[0][2][1]`` is "tower 1 height 3 above").
 
 Tables recorded by hand are often incomplete, and the schema accepts what students write:
 
@@ -16,15 +17,20 @@ Tables recorded by hand are often incomplete, and the schema accepts what studen
   one tower; the file is represented as it is (one entry per slot) and :attr:`RecordedTable.shared_above` names
   the groups.
 
-:func:`read_recorded_table` returns what is present (:class:`RecordedTable`, a masked array); :func:`read_table` is
-for consumers that need every entry and refuses an incomplete table, naming the missing entries.
+:func:`read_recorded_table` returns what is present (:class:`RecordedTable`, a masked array); every table reader
+uses it. :meth:`RecordedTable.for_solve` is the rule of the table followers (``solve --table``, ``ros-solve
+--table``): the entries the solve visits must be present, the others may be missing (:mod:`~ur3hanoi.labfile.visits`).
+:func:`read_table` is for consumers that need every entry and refuses an incomplete table, naming the missing
+entries.
 
-Writing (:func:`write_table`) replaces only the keys it generates: every other key keeps its exact text, the bytes
-are a pure function of the inputs, and the read-modify-write holds a lock and ends in an atomic replace
-(:mod:`ur3hanoi.io.atomic`), so concurrent writers of different keys never lose one.
+Writing (:func:`write_table`) replaces one key's text and keeps every other byte of the file (see
+:mod:`~ur3hanoi.labfile.write`); angles are written with :data:`ANGLE_DECIMALS` decimals so the file is the same on
+every CPU; the read-modify-write holds a lock and ends in an atomic replace (:mod:`ur3hanoi.io.atomic`), so
+concurrent writers of different keys never lose one.
 
-Module map: :mod:`~ur3hanoi.labfile.read` (schema, strict reading, :class:`RecordedTable`) and
-:mod:`~ur3hanoi.labfile.write` (formatting a key, splicing it into the file, the locked atomic update).
+Module map: :mod:`~ur3hanoi.labfile.read` (schema, reading a key, :class:`RecordedTable`),
+:mod:`~ur3hanoi.labfile.visits` (the entries a solve visits) and :mod:`~ur3hanoi.labfile.write` (formatting a key,
+splicing it into the file, the locked atomic update).
 """
 
 from __future__ import annotations
@@ -36,6 +42,7 @@ from ur3hanoi.labfile.read import (
     LabFile,
     RecordedTable,
     Slot,
+    lab_key,
     parse_q,
     read_lab_file,
     read_recorded_table,
@@ -43,22 +50,39 @@ from ur3hanoi.labfile.read import (
     recorded_table_of,
     table_of,
 )
-from ur3hanoi.labfile.write import format_q, format_xy, splice_yaml, write_table
+from ur3hanoi.labfile.visits import entries_visited, entry_label, missing_entries, require_entries
+from ur3hanoi.labfile.write import (
+    ANGLE_DECIMALS,
+    FILE_HEADER,
+    format_number,
+    format_q,
+    format_xy,
+    splice_yaml,
+    write_table,
+)
 
 __all__ = [
+    "ANGLE_DECIMALS",
     "BLOCK_XY_KEY",
+    "FILE_HEADER",
     "LAB_FILE_SCHEMA",
     "TABLE_KEYS",
     "LabFile",
     "RecordedTable",
     "Slot",
+    "entries_visited",
+    "entry_label",
+    "format_number",
     "format_q",
     "format_xy",
+    "lab_key",
+    "missing_entries",
     "parse_q",
     "read_lab_file",
     "read_recorded_table",
     "read_table",
     "recorded_table_of",
+    "require_entries",
     "splice_yaml",
     "table_of",
     "write_table",

@@ -15,9 +15,11 @@ import numpy.typing as npt
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import TableError, printable, quote
-from ur3hanoi.io.schema import Field, ListOf, Nullable, Number, Record, Spec, Vector
+from ur3hanoi.hanoi import solve_hanoi, validate_instance
+from ur3hanoi.io.schema import Field, ListOf, Nullable, Number, Record, Spec, Vector, describe_type, suggest
 from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
+from ur3hanoi.labfile.visits import require_entries
 from ur3hanoi.robot import N_JOINTS
 from ur3hanoi.station import MAX_HEIGHTS, MAX_TOWERS
 from ur3hanoi.waypoints import pose_label
@@ -46,28 +48,40 @@ LAB_FILE_SCHEMA = Record({
     "sim_pos": Field(Q_SCHEMA, required=False),
     "real_pos": Field(Q_SCHEMA, required=False),
     BLOCK_XY_KEY: Field(BLOCK_XY_SCHEMA, required=False),
-})
-"""The lab table file's schema: these three keys, each optional, nothing else."""
+}, others=True)
+"""The lab table file's schema: a mapping; ur3hanoi's three keys, each optional; any other key is the student's
+and may hold anything. A reader checks only the key it reads (:func:`lab_key`): a malformed ``real_pos`` does not
+stop anyone from reading ``sim_pos``."""
 
 
 @dataclass(frozen=True)
 class LabFile:
-    """A validated lab table file: ``data`` (key -> value), its ``text`` and the sha256 of its bytes."""
+    """A lab table file whose top level is a mapping: ``data`` (key -> value, not checked), its ``text`` (without
+    a byte-order mark; ``bom`` says whether the file had one) and the sha256 of its bytes."""
 
-    data: dict[str, Any]
+    data: dict[Any, Any]
     text: str
     sha256: str
+    bom: bool = False
 
 
-def validate_lab_data(data: Any, source: str) -> dict[str, Any]:
-    """Check a parsed lab table file (:data:`LAB_FILE_SCHEMA`, rectangular tables); its data as a dict."""
-    if data is None:
-        return {}
-    validate_schema(data, LAB_FILE_SCHEMA, source, TableError)
-    for key in (*TABLE_KEYS, BLOCK_XY_KEY):
-        if key in data:
-            _check_rectangular(data[key], source, key)
-    return dict(data)
+def lab_key(data: dict[Any, Any], key: str, source: str) -> Any:
+    """The value of ``key`` in a lab file's data, checked against its schema in :data:`LAB_FILE_SCHEMA` (only
+    that key: the others may hold anything).
+
+    Raises:
+        TableError: ``key`` is absent (the nearest key present is suggested) or its value is invalid.
+    """
+    if key not in data:
+        present = [k for k in data if isinstance(k, str)]
+        near = suggest(key, present)
+        hint = f"; is '{printable(near, 60)}' a misspelling of it?" if near is not None else ""
+        known = ", ".join(k for k in present if k in TABLE_KEYS) or "none"
+        raise TableError(f"{printable(source)}: key '{key}' not found (table keys present: {known}){hint}")
+    value = data[key]
+    validate_schema(value, LAB_FILE_SCHEMA.fields[key].spec, source, TableError, path=key)
+    _check_rectangular(value, source, key)
+    return value
 
 
 def _check_rectangular(value: list[Any], source: str, key: str) -> None:
@@ -83,14 +97,19 @@ def _check_rectangular(value: list[Any], source: str, key: str) -> None:
 
 
 def read_lab_file(path: str | Path, source: str | None = None) -> LabFile:
-    """Read and validate a lab table file (strict YAML, :data:`LAB_FILE_SCHEMA`); ``source`` names it in messages.
+    """Read a lab table file (strict YAML); ``source`` names it in messages. Only the top level is checked (a
+    mapping, or an empty file): each key is checked when it is read (:func:`lab_key`).
 
     Raises:
-        TableError: unreadable, not strict YAML, or not matching the schema; the message names file and field.
+        TableError: unreadable, not strict YAML, or its top level is not a mapping; the message names the file.
     """
     source = str(path) if source is None else source
     doc = load_yaml_file(path, what=WHAT, error=TableError, source=source)
-    return LabFile(data=validate_lab_data(doc.data, source), text=doc.text, sha256=doc.sha256)
+    data = {} if doc.data is None else doc.data
+    if not isinstance(data, dict):
+        raise TableError.file(source, f"the top level is {describe_type(data)}, not a mapping of keys "
+                                      f"({', '.join(LAB_FILE_SCHEMA.fields)}, or your own): not a {WHAT}")
+    return LabFile(data=data, text=doc.text, sha256=doc.sha256, bom=doc.bom)
 
 
 def parse_q(value: Any, source: str, key: str) -> FloatArray:
@@ -100,8 +119,7 @@ def parse_q(value: Any, source: str, key: str) -> FloatArray:
     Raises:
         TableError: invalid, or some entry is missing (the message names them).
     """
-    validate_schema(value, Q_SCHEMA, source, TableError, path=key)
-    _check_rectangular(value, source, key)
+    value = lab_key({key: value}, key, source)
     return _recorded(value, source, key, "").full()
 
 
@@ -149,6 +167,19 @@ class RecordedTable:
             if t == tower and height in heights:
                 return heights
         return ()
+
+    def for_solve(self, start: int, end: int, n_blocks: int) -> FloatArray:
+        """``q`` for solving ``n_blocks`` from tower ``start`` to ``end`` (0-based): every entry the solve visits
+        must be present; entries it never visits may be missing (NaN). The rule of every table follower
+        (:func:`ur3hanoi.labfile.visits.require_entries`).
+
+        Raises:
+            PuzzleError: the instance does not fit the table's towers x heights.
+            TableError: entries the solve visits are missing (all of them are named).
+        """
+        validate_instance(n_blocks, start, end, self.n_towers, self.n_heights)
+        require_entries(self.q, solve_hanoi(n_blocks, start, end, self.n_towers, self.n_heights), self.source)
+        return self.q
 
     def full(self) -> FloatArray:
         """``q`` when every entry is present.
@@ -208,10 +239,7 @@ def read_recorded_table(path: str | Path, key: str) -> RecordedTable:
 def recorded_table_of(lab: LabFile, path: str | Path, key: str) -> RecordedTable:
     """:func:`read_recorded_table` of an already read :class:`LabFile` (read from ``path``)."""
     check_key(key)
-    if key not in lab.data:
-        present = ", ".join(k for k in lab.data if k in TABLE_KEYS) or "none"
-        raise TableError(f"{printable(path)}: key '{key}' not found (table keys present: {present})")
-    return _recorded(lab.data[key], str(path), key, lab.sha256)
+    return _recorded(lab_key(lab.data, key, str(path)), str(path), key, lab.sha256)
 
 
 def read_table(path: str | Path, key: str) -> FloatArray:
@@ -247,11 +275,11 @@ __all__ = [
     "RecordedTable",
     "Slot",
     "check_key",
+    "lab_key",
     "parse_q",
     "read_lab_file",
     "read_recorded_table",
     "read_table",
     "recorded_table_of",
     "table_of",
-    "validate_lab_data",
 ]

@@ -58,13 +58,14 @@ Ruckig from rest to rest between the same waypoints, same limits and dwells: ``P
 the exact-vertical stop-and-go the project used to compare with is ``Plan.exact_vertical_stop_and_go_duration_s``.
 """
 
+from ur3hanoi.labfile.visits import entries_visited, entry_label, missing_entries
 from ur3hanoi.plan.checks import check_limits, check_vertical, tcp_positions_world
 from ur3hanoi.plan.collision import CollisionScene, check_collisions
 from ur3hanoi.plan.export import trajectory_csv
 from ur3hanoi.plan.planner import plan_moves, plan_solve
 from ur3hanoi.plan.ruckig import OfflineRuckig, RuckigSolution, control_samples, to_pose, to_rest
 from ur3hanoi.plan.sampling import sample
-from ur3hanoi.plan.table_plan import check_table_shape, entries_visited, entry_label, missing_entries, plan_table
+from ur3hanoi.plan.table_plan import check_table_shape, plan_table
 from ur3hanoi.plan.types import (
     DEFAULT_VIA_ACCELS,
     DEFAULT_VIA_SPEEDS,

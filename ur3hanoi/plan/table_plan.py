@@ -28,15 +28,15 @@ Segment targets name the table entry a segment ends at, 1-based with the file's 
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
 
 import numpy as np
 from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError, TableError, printable
-from ur3hanoi.grid import ABOVE, ON, POSE_NAMES
-from ur3hanoi.hanoi import Move, check_sequence, solve_hanoi, validate_instance
+from ur3hanoi.grid import ABOVE, ON
+from ur3hanoi.hanoi import check_sequence, solve_hanoi, validate_instance
+from ur3hanoi.labfile.visits import entry_label, require_entries
 from ur3hanoi.plan.checks import check_limits
 from ur3hanoi.plan.ruckig import OfflineRuckig
 from ur3hanoi.plan.sampling import sample
@@ -44,32 +44,9 @@ from ur3hanoi.plan.types import Phase, Plan, PlanConfig, Segment
 from ur3hanoi.robot import N_JOINTS
 from ur3hanoi.station import Station
 
-Entry = tuple[int, int, int]  # (tower, height, k), 0-based as the file indexes the table
-
-
-def entry_label(tower: int, height: int, k: int) -> str:
-    """``"tower 1 height 3 on (Q[0][2][0])"``: 1-based for people, with the file's 0-based list index."""
-    return f"tower {tower + 1} height {height + 1} {POSE_NAMES[k]} (Q[{tower}][{height}][{k}])"
-
 
 def _target(tower: int, height: int, k: int) -> str:
     return f"table entry {entry_label(tower, height, k)}"
-
-
-def entries_visited(moves: Sequence[Move]) -> list[Entry]:
-    """The table entries a move sequence visits, in order of first visit (on and above of every source and
-    destination slot)."""
-    seen: dict[Entry, None] = {}
-    for m in moves:
-        for t, h in ((m.from_tower, m.from_height), (m.to_tower, m.to_height)):
-            seen.setdefault((t, h, ABOVE))
-            seen.setdefault((t, h, ON))
-    return list(seen)
-
-
-def missing_entries(table: FloatArray, moves: Sequence[Move]) -> list[Entry]:
-    """The entries ``moves`` visit that ``table`` (T, H, 2, 6) lacks (any NaN joint), sorted by index."""
-    return sorted(e for e in entries_visited(moves) if not np.all(np.isfinite(table[e])))
 
 
 def check_table_shape(table: FloatArray, station: Station, where: str = "table") -> None:
@@ -148,12 +125,7 @@ def plan_table(station: Station, table: FloatArray, start: int, end: int, n_bloc
     validate_instance(n_blocks, start, end, station.n_towers, station.n_heights)
     moves = solve_hanoi(n_blocks, start, end, station.n_towers, station.n_heights)
     check_sequence(moves, n_blocks, start, end, station.n_towers, station.n_heights)
-    missing = missing_entries(table, moves)
-    if missing:
-        names = "; ".join(entry_label(*e) for e in missing)
-        raise TableError(f"{printable(where)}: {len(missing)} table "
-                         f"entr{'y' if len(missing) == 1 else 'ies'} the solve needs "
-                         f"{'is' if len(missing) == 1 else 'are'} missing: {names}")
+    require_entries(table, moves, where)  # the rule of every table follower (ros-solve's too)
 
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
