@@ -110,8 +110,9 @@ def wall(repeats: int = 5) -> float:
         path = rt.write_table(Path(d) / "t.yaml", "real_pos", rt.table_doc(q))
         for _ in range(repeats):
             t0 = time.perf_counter()
-            subprocess.run([str(Path(sys.executable).parent / "ur3hanoi"), "check-table", str(path), "--key", "real_pos", "--fit"],
-                           check=False, capture_output=True)
+            cmd = [str(Path(sys.executable).parent / "ur3hanoi"), "check-table", str(path), "--key", "real_pos",
+                   "--fit"]
+            subprocess.run(cmd, check=False, capture_output=True)
             walls.append(time.perf_counter() - t0)
     return float(np.median(walls))
 

@@ -164,7 +164,7 @@ class RobustFit:
 
 def _evaluate(base: Station, model: GridModel, slots: Sequence[Slot], m: Measured, used: BoolArray,
               candidates: BoolArray, tol_mm: float | None, tol_deg: float | None,
-              frozen: Thresholds | None = None) -> RobustFit:
+              frozen: Thresholds | None = None, angle_deg: FloatArray | None = None) -> RobustFit:
     idx = np.flatnonzero(used)
     used_slots = [slots[i] for i in idx]
     solution = solve(base, model, used_slots, m.p_world[idx])
@@ -174,7 +174,7 @@ def _evaluate(base: Station, model: GridModel, slots: Sequence[Slot], m: Measure
     loo, can = leave_one_out(model, used_slots, m.p_world[idx], solution)
     deviation[idx[can]] = loo[can]
     removable[idx] = can
-    rot = rotation_error_deg(m.R_world, yaw)
+    rot = rotation_error_deg(m.R_world, yaw) if angle_deg is None else angle_deg
     dev_mm = np.linalg.norm(deviation, axis=1) * 1e3
     # The scale comes from every candidate, in the fit or not: the points of the fit alone are the closest ones
     # (after the trimmed start) and would understate it; the median ignores the gross errors among the others.
@@ -265,11 +265,14 @@ class _Lts:
 
 
 def robust_fit(base: Station, model: GridModel, slots: Sequence[Slot], m: Measured, candidates: BoolArray,
-               tol_mm: float | None = None, tol_deg: float | None = None) -> RobustFit:
+               tol_mm: float | None = None, tol_deg: float | None = None, angle_deg: FloatArray | None = None
+               ) -> RobustFit:
     """Fit ``model`` to the ``candidates`` among the points measured at ``slots``, leaving out gross errors
     (see the module docstring).
 
     ``candidates`` must determine ``model``. ``tol_mm`` / ``tol_deg`` replace the derived thresholds.
+    ``angle_deg`` (N,) replaces the orientation error judged with each point (default: its angle from the grid
+    pose, heading included); zeros judge positions only (the audit checks the suction axis on its own).
     """
     cand = np.flatnonzero(candidates)
     starts = _Lts(base, model, slots, m.p_world).starts(cand) if 3 * len(cand) > model.n_unknowns else [cand]
@@ -283,26 +286,27 @@ def robust_fit(base: Station, model: GridModel, slots: Sequence[Slot], m: Measur
     # points agree" compares like with like; the winner is then refined with the thresholds of its own fit.
     # Thresholds stay fixed while a fit grows and shrinks: re-estimating them after every change could swing a
     # point in and out.
-    frozen = _evaluate(base, model, slots, m, mask(starts[0]), candidates, tol_mm, tol_deg).thresholds
+    frozen = _evaluate(base, model, slots, m, mask(starts[0]), candidates, tol_mm, tol_deg, None, angle_deg).thresholds
     best: RobustFit | None = None
     for start in starts:
-        fit = _grow_and_prune(base, model, slots, m, mask(start), candidates, tol_mm, tol_deg, frozen)
+        fit = _grow_and_prune(base, model, slots, m, mask(start), candidates, tol_mm, tol_deg, frozen, angle_deg)
         if best is None or int(fit.used.sum()) > int(best.used.sum()):
             best = fit  # on a tie the earlier start: the better trimmed fit
     assert best is not None
-    frozen = _evaluate(base, model, slots, m, best.used, candidates, tol_mm, tol_deg).thresholds
-    fit = _grow_and_prune(base, model, slots, m, best.used, candidates, tol_mm, tol_deg, frozen)
-    return replace(_evaluate(base, model, slots, m, fit.used, candidates, tol_mm, tol_deg), thresholds=frozen)
+    frozen = _evaluate(base, model, slots, m, best.used, candidates, tol_mm, tol_deg, None, angle_deg).thresholds
+    fit = _grow_and_prune(base, model, slots, m, best.used, candidates, tol_mm, tol_deg, frozen, angle_deg)
+    return replace(_evaluate(base, model, slots, m, fit.used, candidates, tol_mm, tol_deg, None, angle_deg),
+                   thresholds=frozen)
 
 
 def _grow_and_prune(base: Station, model: GridModel, slots: Sequence[Slot], m: Measured, used: BoolArray,
-                    candidates: BoolArray, tol_mm: float | None, tol_deg: float | None, frozen: Thresholds
-                    ) -> RobustFit:
+                    candidates: BoolArray, tol_mm: float | None, tol_deg: float | None, frozen: Thresholds,
+                    angle_deg: FloatArray | None = None) -> RobustFit:
     """Step 3 of the module docstring, from the points ``used``, with the thresholds ``frozen``."""
     n_cand = int(candidates.sum())
     max_left_out = (n_cand - 1) // 2
     used = used.copy()
-    fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen)
+    fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen, angle_deg)
     for _ in range(4 * n_cand + 4):
         outside = np.where(candidates & ~used, fit.severity, np.inf)
         inside = np.where(used & fit.removable, fit.severity, -np.inf)
@@ -313,7 +317,7 @@ def _grow_and_prune(base: Station, model: GridModel, slots: Sequence[Slot], m: M
             used[drop] = False
         else:
             break
-        fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen)
+        fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen, angle_deg)
     return fit
 
 
