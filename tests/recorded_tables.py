@@ -174,17 +174,36 @@ class RecordedLike:
     axis: np.ndarray
 
 
-def recorded_like(station: Station, rng: np.random.Generator, tilted: Slot | None = None,
-                  tilt_deg: tuple[float, float] = (5.0, 6.0)) -> RecordedLike:
-    """A table as a student records it on ``station`` (see the constants above); with ``tilted``, that entry's
-    suction axis is U(5, 6) deg off the table's (a real mistake) while its suction point is still on the block."""
-    from ur3hanoi.grid import R_world_tcp_down
+def pose_q(station: Station, p_world: np.ndarray, R_world: np.ndarray) -> np.ndarray:
+    """Joint values [rad] (home's branch, nearest home) putting the suction point at ``p_world`` [m] with
+    orientation ``R_world`` (closed-form IK)."""
     from ur3hanoi.ik import analytic_ik, branch_of, wrap_angle
 
     robot = load_ur3(station.tool, station.limits)
     home = station.q_home_array
     branch = branch_of(home)
-    T_wb = station.T_world_base
+    T_base_tool0 = station.T_world_base.actInv(pin.SE3(R_world, p_world)) * robot.T_tcp_tool0
+    sol = analytic_ik(T_base_tool0, only=branch)
+    if branch not in sol:
+        raise ValueError(f"pose {np.round(p_world, 4).tolist()} unreachable on home's branch")
+    return np.asarray(home + wrap_angle(sol[branch] - home))
+
+
+def R_tcp(heading: float, tilt_deg: float = 0.0, tilt_about: float = 0.0) -> np.ndarray:
+    """Suction axis tilted ``tilt_deg`` off straight down (about the horizontal axis at ``tilt_about`` [rad]), TCP x
+    along ``heading`` [rad]."""
+    from ur3hanoi.grid import R_world_tcp_down
+
+    turn = pin.exp3(np.array([math.cos(tilt_about), math.sin(tilt_about), 0.0]) * math.radians(tilt_deg))
+    return np.asarray(turn @ R_world_tcp_down(heading))
+
+
+def recorded_like(station: Station, rng: np.random.Generator, tilted: Slot | None = None,
+                  tilt_deg: tuple[float, float] = (5.0, 6.0)) -> RecordedLike:
+    """A table as a student records it on ``station`` (see the constants above); with ``tilted``, that entry's
+    suction axis is U(5, 6) deg off the table's (a real mistake) while its suction point is still on the block."""
+    from ur3hanoi.grid import R_world_tcp_down
+
     table_tilt = _tilted(rng, TABLE_TILT_DEG)
     axis = table_tilt @ np.array([0.0, 0.0, -1.0])
     top = max(T_world_tcp(station, t, station.n_heights - 1, ON).translation[2] for t in range(station.n_towers))
@@ -200,10 +219,5 @@ def recorded_like(station: Station, rng: np.random.Generator, tilted: Slot | Non
                 heading = tower_heading + math.radians(rng.uniform(-WRIST3_DEG, WRIST3_DEG))
                 entry = (_tilted(rng, 0.0, rng.uniform(*tilt_deg)) if (t, h, k) == tilted
                          else _tilted(rng, ENTRY_TILT_DEG))
-                R = entry @ table_tilt @ R_world_tcp_down(heading)
-                T_base_tool0 = T_wb.actInv(pin.SE3(R, p)) * robot.T_tcp_tool0
-                sol = analytic_ik(T_base_tool0, only=branch)
-                if branch not in sol:
-                    raise ValueError(f"recorded-like pose {(t, h, k)} unreachable on home's branch")
-                q[t, h, k] = home + wrap_angle(sol[branch] - home)
+                q[t, h, k] = pose_q(station, p, entry @ table_tilt @ R_world_tcp_down(heading))
     return RecordedLike(station=station, q=q, axis=axis)

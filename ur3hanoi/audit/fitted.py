@@ -32,6 +32,7 @@ from ur3hanoi.calibrate.grid_fit import GridModel, Measured, measure
 from ur3hanoi.calibrate.robust import RobustFit, Thresholds, robust_fit
 from ur3hanoi.calibrate.rule import (
     ABOVE_CLEAR_MM,
+    CONTACT_FLAG_MM,
     CONTACT_OK_MM,
     TILT_FLAG_DEG,
     TILT_OK_DEG,
@@ -98,7 +99,7 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
     slots: list[Slot] = [(t, h, k) for t in range(n_t) for h in range(n_h) for k in (ON, ABOVE)
                          if table.present[t, h, k]]
     qs = np.array([table.q[s] for s in slots], dtype=float).reshape(-1, 6)
-    m = measure(grid, qs)
+    m = measure(grid, [tuple(float(v) for v in q) for q in qs])
     axes = m.R_world[:, :, 2]
     in_limits = np.array([grid.limits.within_position(q) for q in qs], dtype=bool)
     c_idx = np.flatnonzero(np.array([s[2] == ON for s in slots], dtype=bool) & in_limits)
@@ -118,8 +119,10 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
     tilt = angle_deg(axes, axis)
     mc = Measured(p_world=m.p_world[c_idx], R_world=m.R_world[c_idx], heading=m.heading[c_idx],
                   tilt_deg=m.tilt_deg[c_idx])
-    fit = robust_fit(grid, model, c_slots, mc, np.ones(len(c_idx), dtype=bool), tol_deg=1.0,
-                     angle_deg=np.zeros(len(c_idx)))
+    # Contacts within the warning distance of the grid of the others (5 sigma of the data, clamped to 5-8 mm) stay
+    # in the fit: one further off would drag its neighbours. Positions only: the axis is checked on its own.
+    fit = robust_fit(grid, model, c_slots, mc, np.ones(len(c_idx), dtype=bool), tol_mm=tol_mm, tol_deg=1.0,
+                     angle_deg=np.zeros(len(c_idx)), mm_range=(CONTACT_OK_MM, CONTACT_FLAG_MM))
     sol = fit.solution
     layout = (("flat" if math.hypot(sol.step[0], sol.step[1]) > abs(sol.step[2]) else "stacked") if step_fitted
               else base.layout)
@@ -141,15 +144,17 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
         else:
             v = judge_contact(0.0, 0.0, float(tilt[i]), rule)
             if v.status == "ok":
-                v = Verdict("unchecked", 0.0, f"the only contact of tower {s[0] + 1}: nothing else fixes its line, "
-                                              f"so its position cannot be checked (record another height of tower "
-                                              f"{s[0] + 1} to check it)")
+                alone = ("the only contact of tower" if sum(c[0] == s[0] for c in c_slots) == 1 else
+                         "the only contact the fit keeps (the others are off) of tower")
+                v = Verdict("unchecked", 0.0, f"{alone} {s[0] + 1}: nothing else fixes its line, so its position "
+                                              f"cannot be checked (record another height of tower {s[0] + 1} to "
+                                              "check it)")
         verdicts[s] = v
         entries[s] = AuditEntry(
-            *s, field=field[s], error_mm=float(np.linalg.norm(d)), rot_deg=math.nan, tilt_deg=float(tilt[i]),
+            tower=s[0], height=s[1], k=s[2], field=field[s],
+            error_mm=float(np.linalg.norm(d)), rot_deg=math.nan, tilt_deg=float(tilt[i]),
             status="suspect" if v.status == "flagged" else v.status, reason=v.why, q=tuple(float(x) for x in qs[i]),
-            point_m=_xyz(m.p_world[i]),
-            fitted_m=_xyz(m.p_world[i] - dev[j]), off_line_mm=math.hypot(d[0], d[1]) if checkable[j] else math.nan,
+            point_m=_xyz(m.p_world[i]), fitted_m=_xyz(m.p_world[i] - dev[j]), off_line_mm=math.hypot(d[0], d[1]) if checkable[j] else math.nan,
             off_level_mm=float(d[2]) if checkable[j] else math.nan)
 
     for i, s in enumerate(slots):
@@ -158,19 +163,19 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
         c = sol.point((s[0], s[1], ON))
         p = m.p_world[i]
         if s[2] == ON:  # outside the joint limits
-            v = Verdict("suspect", math.inf, limits_why)
+            v = Verdict("flagged", math.inf, limits_why)
             d = (p - c) * 1e3
-            entries[s] = AuditEntry(*s, field=field[s], error_mm=float(np.linalg.norm(d)), rot_deg=math.nan,
-                                    tilt_deg=float(tilt[i]), status="suspect", q=tuple(float(x) for x in qs[i]),
-                                    point_m=_xyz(p), fitted_m=_xyz(c), off_line_mm=math.hypot(d[0], d[1]),
-                                    off_level_mm=float(d[2]), reason=limits_why)
+            entries[s] = AuditEntry(
+                tower=s[0], height=s[1], k=s[2], field=field[s], error_mm=float(np.linalg.norm(d)), rot_deg=math.nan,
+                tilt_deg=float(tilt[i]), status="suspect", q=tuple(float(x) for x in qs[i]), point_m=_xyz(p),
+                fitted_m=_xyz(c), off_line_mm=math.hypot(d[0], d[1]), off_level_mm=float(d[2]), reason=limits_why)
             verdicts[s] = v
             continue
         off_line = math.hypot(float(p[0] - c[0]), float(p[1] - c[1])) * 1e3
         over_top, over_contact = (float(p[2]) - top_z) * 1e3, float(p[2] - c[2]) * 1e3
         v = judge_above(off_line, over_top, over_contact)
         if not in_limits[i]:
-            v = Verdict("suspect", math.inf, "; ".join(x for x in (v.why, limits_why) if x))
+            v = Verdict("flagged", math.inf, "; ".join(x for x in (v.why, limits_why) if x))
         shared = table.shared_with(s[0], s[1])
         if shared and v.why:
             v = replace(v, why=f"the above pose shared by heights {', '.join(str(h + 1) for h in shared)} of tower "
@@ -178,7 +183,8 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
         target = np.array([c[0], c[1], max(float(p[2]), top_z + ABOVE_CLEAR_MM * 1e-3)])
         verdicts[s] = v
         entries[s] = AuditEntry(
-            *s, field=field[s], error_mm=float(np.linalg.norm(p - target)) * 1e3, rot_deg=math.nan,
+            tower=s[0], height=s[1], k=s[2], field=field[s],
+            error_mm=float(np.linalg.norm(p - target)) * 1e3, rot_deg=math.nan,
             tilt_deg=float(tilt[i]), status="suspect" if v.status == "flagged" else v.status,
             q=tuple(float(x) for x in qs[i]), point_m=_xyz(p), fitted_m=_xyz(target), off_line_mm=off_line,
             over_top_mm=over_top, over_contact_mm=over_contact, reason=v.why)

@@ -55,6 +55,10 @@ WARN_SIGMAS = 5.0
 """Warnings start this many robust sigmas of the table's own scatter out (clamped to the floors and ceilings)."""
 MIN_CONTACTS_FOR_SCALE = 6
 """Fewer checkable contacts than this give no scatter estimate: warnings start at the floors."""
+SIGMA_FLOOR_MM = 0.1
+"""[mm] no table scatters less than a real UR3 repeats (about 0.1 mm): the smallest scatter an audit assumes."""
+SIGMA_FLOOR_DEG = 0.05
+"""[deg] the smallest scatter of the suction axes an audit assumes."""
 MAXWELL_MEDIAN = 1.5382
 """Median length of a 3-D standard normal vector: per-axis sigma = median distance / 1.538."""
 RAYLEIGH_MEDIAN = 1.1774
@@ -71,8 +75,8 @@ def angle_deg(a: FloatArray, b: FloatArray) -> FloatArray:
 def table_axis(axes: FloatArray) -> FloatArray:
     """The table's own suction axis (unit vector, world): the robust mean of the contacts' axes (N, 3).
 
-    The component-wise median direction, then the mean of the axes within :data:`TILT_OK_DEG` of it (a tilted
-    entry cannot drag it); straight down with fewer than three contacts.
+    The component-wise median direction, then the mean of the axes within ``max(2 deg, 3 x their median angle)``
+    of it (a tilted entry cannot drag it); straight down with fewer than three contacts.
     """
     axes = np.asarray(axes, dtype=float).reshape(-1, 3)
     down = np.array([0.0, 0.0, -1.0])
@@ -80,7 +84,8 @@ def table_axis(axes: FloatArray) -> FloatArray:
         return down
     a = np.median(axes, axis=0)
     a = a / np.linalg.norm(a)
-    near = angle_deg(axes, a) <= TILT_OK_DEG
+    off = angle_deg(axes, a)
+    near = off <= max(2.0, 3.0 * float(np.median(off)))
     if near.sum() >= 2:
         a = axes[near].mean(axis=0)
         a = a / np.linalg.norm(a)
@@ -96,8 +101,9 @@ class AuditRule:
         flag_mm: ... is flagged [mm] (8, or a fixed tolerance).
         warn_deg: a contact's axis further than this from the table's gets a warning [deg], in [4, 5].
         flag_deg: ... is flagged [deg] (5, or a fixed tolerance).
-        sigma_mm: robust scatter of the contacts per axis [mm] (NaN: too few to estimate).
-        sigma_deg: robust scatter of the contacts' axes [deg] (NaN: too few).
+        sigma_mm: robust scatter of the contacts per axis [mm], at least :data:`SIGMA_FLOOR_MM` (NaN: too few to
+            estimate).
+        sigma_deg: robust scatter of the contacts' axes [deg], at least :data:`SIGMA_FLOOR_DEG` (NaN: too few).
         fixed: True when ``flag_mm`` / ``flag_deg`` were given (``--tol-mm`` / ``--tol-deg``).
     """
 
@@ -156,8 +162,10 @@ def derive_rule(dev_mm: FloatArray, tilt_deg: FloatArray, tol_mm: float | None =
     dev = dev[np.isfinite(dev)]
     tilt = np.asarray(tilt_deg, dtype=float)
     tilt = tilt[np.isfinite(tilt)]
-    s_mm = float(np.median(dev)) / MAXWELL_MEDIAN if dev.size >= MIN_CONTACTS_FOR_SCALE else math.nan
-    s_deg = float(np.median(tilt)) / RAYLEIGH_MEDIAN if tilt.size >= MIN_CONTACTS_FOR_SCALE else math.nan
+    s_mm = (max(float(np.median(dev)) / MAXWELL_MEDIAN, SIGMA_FLOOR_MM) if dev.size >= MIN_CONTACTS_FOR_SCALE
+            else math.nan)
+    s_deg = (max(float(np.median(tilt)) / RAYLEIGH_MEDIAN, SIGMA_FLOOR_DEG) if tilt.size >= MIN_CONTACTS_FOR_SCALE
+             else math.nan)
     flag_mm = CONTACT_FLAG_MM if tol_mm is None else float(tol_mm)
     flag_deg = TILT_FLAG_DEG if tol_deg is None else float(tol_deg)
     warn_mm = CONTACT_OK_MM if math.isnan(s_mm) else min(max(WARN_SIGMAS * s_mm, CONTACT_OK_MM), CONTACT_FLAG_MM)
@@ -236,6 +244,8 @@ __all__ = [
     "ABOVE_MIN_MM",
     "CONTACT_FLAG_MM",
     "CONTACT_OK_MM",
+    "SIGMA_FLOOR_DEG",
+    "SIGMA_FLOOR_MM",
     "STATUSES",
     "TILT_FLAG_DEG",
     "TILT_OK_DEG",
