@@ -154,7 +154,8 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
             tower=s[0], height=s[1], k=s[2], field=field[s],
             error_mm=float(np.linalg.norm(d)), rot_deg=math.nan, tilt_deg=float(tilt[i]),
             status="suspect" if v.status == "flagged" else v.status, reason=v.why, q=tuple(float(x) for x in qs[i]),
-            point_m=_xyz(m.p_world[i]), fitted_m=_xyz(m.p_world[i] - dev[j]), off_line_mm=math.hypot(d[0], d[1]) if checkable[j] else math.nan,
+            point_m=_xyz(m.p_world[i]), fitted_m=_xyz(m.p_world[i] - dev[j]),
+            off_line_mm=math.hypot(d[0], d[1]) if checkable[j] else math.nan,
             off_level_mm=float(d[2]) if checkable[j] else math.nan)
 
     for i, s in enumerate(slots):
