@@ -40,11 +40,10 @@ def test_inside_the_floors_is_never_flagged(dev: list[float], tilts: list[float]
 
 
 @settings(max_examples=200, deadline=None)
-@given(dev=SCATTER, tilts=SCATTER, off=st.floats(CONTACT_FLAG_MM + 1e-6, 500.0), which=st.sampled_from(["line", "up",
-                                                                                                          "down"]))
-def test_past_the_ceiling_is_always_flagged(dev: list[float], tilts: list[float], off: float, which: str) -> None:
+@given(dev=SCATTER, tilts=SCATTER, off=st.floats(CONTACT_FLAG_MM + 1e-6, 500.0), angle=st.floats(-math.pi, math.pi))
+def test_past_the_ceiling_is_always_flagged(dev: list[float], tilts: list[float], off: float, angle: float) -> None:
     rule = derive_rule(np.array(dev), np.array(tilts))
-    line, level = (off, 0.0) if which == "line" else (0.0, off if which == "up" else -off)
+    line, level = abs(off * math.cos(angle)), off * math.sin(angle)  # 8 mm from where the grid puts it, any way
     v = judge_contact(line, level, 0.0, rule)
     assert v.status == "flagged" and v.severity > 1.0 and f"more than {CONTACT_FLAG_MM:g} mm" in v.why
     assert judge_contact(0.0, 0.0, TILT_FLAG_DEG + 0.01, rule).status == "flagged"

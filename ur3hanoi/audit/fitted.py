@@ -273,7 +273,7 @@ def _notes_and_problem(base: Station, layout: str, step: np.ndarray, step_fitted
                    "line): record at least two heights on every tower (all of them are best), then audit again")
     else:
         off = [e for e in rows if e.k == ON and e.status == "suspect" and not math.isnan(e.off_line_mm)
-               and max(e.off_line_mm, abs(e.off_level_mm)) > rule.flag_mm]
+               and math.hypot(e.off_line_mm, e.off_level_mm) > rule.flag_mm]
         if n_contacts >= 3 and len(off) > (n_contacts - 1) // 2:
             problem = (f"{len(off)} of {n_contacts} contacts are more than {rule.flag_mm:g} mm off the grid fitted to "
                        "the others: the table does not fit one grid. Check that it follows Q[tower][height][on/above] "

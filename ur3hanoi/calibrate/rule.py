@@ -7,10 +7,12 @@ arm arrives from) is never judged: a round cup on a cube does not care.
 
 - never flagged: within :data:`CONTACT_OK_MM` (5 mm) of the line and of the level, axis within
   :data:`TILT_OK_DEG` (4 deg) of the table's;
-- always flagged: more than :data:`CONTACT_FLAG_MM` (8 mm) off the line or the level, or the axis more than
-  :data:`TILT_FLAG_DEG` (5 deg) from the table's;
-- in between a warning when over the data's own threshold, ``WARN_SIGMAS`` (5) robust sigmas of this table's
-  contacts clamped to [5, 8] mm and [4, 5] deg; the table passes.
+- always flagged: the suction point more than :data:`CONTACT_FLAG_MM` (8 mm) from where the grid puts it (in all;
+  within 5 mm of both the line and the level is at most 7.1 mm), or the axis more than :data:`TILT_FLAG_DEG`
+  (5 deg) from the table's;
+- in between a warning when off the line or the level (or the axis) by more than the data's own threshold,
+  ``WARN_SIGMAS`` (5) robust sigmas of this table's contacts clamped to [5, 8] mm and [4, 5] deg; the table
+  passes.
 
 Recording noise on a hand-jogged UR3 is 1-3 mm (the arm itself repeats to about 0.1 mm); a suction cup seals
 within a few degrees. So the data may add warnings, never rejections inside these floors.
@@ -38,7 +40,7 @@ from ur3hanoi.arrays import FloatArray
 CONTACT_OK_MM = 5.0
 """[mm] a contact this close to its tower's line and its level's height is never flagged."""
 CONTACT_FLAG_MM = 8.0
-"""[mm] a contact farther than this off its tower's line or its level's height is always flagged."""
+"""[mm] a contact whose suction point is farther than this from where the grid puts it is always flagged."""
 TILT_OK_DEG = 4.0
 """[deg] a suction axis this close to the table's is never flagged."""
 TILT_FLAG_DEG = 5.0
@@ -97,8 +99,9 @@ class AuditRule:
     """Every threshold one audit used.
 
     Attributes:
-        warn_mm: a contact further than this off its line or level gets a warning [mm], in [5, 8].
-        flag_mm: ... is flagged [mm] (8, or a fixed tolerance).
+        warn_mm: a contact further than this off its line or its level gets a warning [mm], in [5, 8].
+        flag_mm: a contact further than this from where the grid puts it (in all) is flagged [mm] (8, or a fixed
+            tolerance).
         warn_deg: a contact's axis further than this from the table's gets a warning [deg], in [4, 5].
         flag_deg: ... is flagged [deg] (5, or a fixed tolerance).
         sigma_mm: robust scatter of the contacts per axis [mm], at least :data:`SIGMA_FLOOR_MM` (NaN: too few to
@@ -144,9 +147,9 @@ class AuditRule:
         fixed = " (fixed by --tol-mm/--tol-deg)" if self.fixed else ""
         return [
             f"rule: a contact within {CONTACT_OK_MM:g} mm of its tower's line and its level, axis within "
-            f"{TILT_OK_DEG:g} deg of the table's, is never flagged; more than {self.flag_mm:g} mm off or "
-            f"{self.flag_deg:g} deg tilted is flagged{fixed}; a warning over {self.warn_mm:.1f} mm / "
-            f"{self.warn_deg:.1f} deg (the table passes); heading about the suction axis is not judged",
+            f"{TILT_OK_DEG:g} deg of the table's, is never flagged; more than {self.flag_mm:g} mm off in all or "
+            f"{self.flag_deg:g} deg tilted is flagged{fixed}; a warning over {self.warn_mm:.1f} mm off the line or "
+            f"level / {self.warn_deg:.1f} deg (the table passes); heading about the suction axis is not judged",
             f"rule: an above pose at least {ABOVE_CLEAR_MM:g} mm over the top level and within {ABOVE_LINE_MM:g} mm "
             f"of its contact's line is accepted; less than {ABOVE_MIN_MM:g} mm over the top level or its contact, "
             f"or more than {ABOVE_FLAG_LINE_MM:g} mm off the line, is flagged; its tilt is not judged",
@@ -191,8 +194,13 @@ def _sigmas(x: float, sigma: float) -> str:
 
 def judge_contact(off_line_mm: float, off_level_mm: float, tilt_deg: float, rule: AuditRule) -> Verdict:
     """A contact's verdict from its distance off its tower's line [mm], off its level (signed, + above) [mm] and
-    its axis' angle from the table's [deg]."""
-    off = max(off_line_mm, abs(off_level_mm))
+    its axis' angle from the table's [deg].
+
+    Flagged when the suction point is more than ``flag_mm`` from where the grid puts it (the distance in all:
+    a point within 5 mm of both the line and the level is at most 7.1 mm away) or the axis more than ``flag_deg``
+    from the table's; warned when off the line or the level by more than ``warn_mm`` (at least 5 mm), or the axis
+    by more than ``warn_deg`` (at least 4 deg)."""
+    off = math.hypot(off_line_mm, off_level_mm)
     severity = max(off / rule.flag_mm, tilt_deg / rule.flag_deg)
     parts: list[str] = []
     status = "ok"
@@ -201,10 +209,10 @@ def judge_contact(off_line_mm: float, off_level_mm: float, tilt_deg: float, rule
     noise = (f"recording noise is 1-3 mm{_sigmas(off, rule.sigma_mm)}")
     if off > rule.flag_mm:
         status = "flagged"
-        parts.append(f"{where}: more than {rule.flag_mm:g} mm ({noise})")
-    elif off > rule.warn_mm:
+        parts.append(f"{where}: more than {rule.flag_mm:g} mm in all ({noise})")
+    elif max(off_line_mm, abs(off_level_mm)) > rule.warn_mm:
         status = "warn"
-        parts.append(f"{where}: more than {rule.warn_mm:.1f} mm, within {rule.flag_mm:g} mm ({noise})")
+        parts.append(f"{where}: more than {rule.warn_mm:.1f} mm, within {rule.flag_mm:g} mm in all ({noise})")
     if tilt_deg > rule.flag_deg:
         status = "flagged"
         parts.append(f"its suction axis is {tilt_deg:.1f} deg from the table's: more than {rule.flag_deg:g} deg (a "
