@@ -261,6 +261,14 @@ def test_a_small_deviation_is_not_called_a_typo(tmp_path: Path) -> None:
     assert 5.0 < warning.error_mm < 8.0
 
 
+def test_on_and_above_swapped_are_named(tmp_path: Path) -> None:
+    rng = np.random.default_rng(12)
+    q = rt.recorded_like(rt.stacked_station(rng), rng).q
+    report = _audit(tmp_path, rt.swap(q, (0, 1, ON), (0, 1, ABOVE)))
+    assert {(s.tower, s.height, s.k) for s in report.suspects} == {(0, 1, ON), (0, 1, ABOVE)}, report.text()
+    assert all("on and above swapped with tower 1 height 2" in s.reason for s in report.suspects)
+
+
 def test_a_tilt_says_how_far_and_why(tmp_path: Path) -> None:
     st = load_station("lab_real")
     report = _audit(tmp_path, _moved(st, _exact(st), (2, 1, ON), (0, 0, 0), tilt_deg=6.0))

@@ -195,6 +195,7 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
     for s, why in reasons.items():
         entries[s] = replace(entries[s], status="suspect" if verdicts[s].status == "flagged" else verdicts[s].status,
                              reason=why)
+    _on_above_swaps(entries, rule)
 
     rows = tuple(entries.get((t, h, k)) or AuditEntry(t, h, k, f"{table.key}[{t}][{h}][{k}]", math.nan, math.nan,
                                                        math.nan, "missing")
@@ -251,6 +252,19 @@ def _contact_reasons(table: RecordedTable, base: Station, slots: list[Slot], qs:
             parts.append(what[j])
         out[s] = "; ".join(parts)
     return out
+
+
+def _on_above_swaps(entries: dict[Slot, AuditEntry], rule: AuditRule) -> None:
+    """Name a slot whose contact and above poses were swapped: the flagged contact is over its level and the above
+    pose stands where the contact should be (within the flag distance)."""
+    for (t, h, k), e in list(entries.items()):
+        above = entries.get((t, h, ABOVE))
+        if k != ON or e.status != "suspect" or above is None or above.status != "suspect" or not e.off_level_mm > 0:
+            continue
+        if math.dist(above.point_m, e.fitted_m) * 1e3 <= rule.flag_mm:
+            what = f"on and above swapped with {above.label} ({above.field}): it stands where this contact should be"
+            entries[(t, h, k)] = replace(e, reason=f"{e.reason}; {what}")
+            entries[(t, h, ABOVE)] = replace(above, reason=f"{above.reason}; on and above swapped with {e.label}")
 
 
 def _notes_and_problem(base: Station, layout: str, step: np.ndarray, step_fitted: bool, axis: np.ndarray,
