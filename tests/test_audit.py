@@ -312,6 +312,24 @@ def test_a_table_only_conditioning_stops_says_so(tmp_path: Path) -> None:
         "record at least two heights on every tower" in report.problem
 
 
+def test_copied_heights_or_towers_are_a_problem_not_a_fit(tmp_path: Path) -> None:
+    rng = np.random.default_rng(13)
+    q = rt.recorded_like(rt.stacked_station(rng), rng).q
+    same = q.copy()
+    same[:, :, ON] = q[:, :1, ON]  # every height holds the bottom contact: the grid fits them exactly
+    report = _audit(tmp_path, same)
+    assert report.failed and report.problem.startswith("the table's levels are 0.0 mm apart")
+    assert report.text().splitlines()[-1].endswith("; the table fails: it cannot be audited as it is")
+    copied_tower = np.concatenate([q, q[:1]], axis=0)  # a fourth tower copied from the first
+    report = _audit(tmp_path, copied_tower)
+    assert report.failed and report.problem.startswith("towers 1 and 4 stand 0.0 mm apart")
+    above = q.copy()
+    above[2, 0, ABOVE] = q[2, 0, ON]
+    (suspect,) = _audit(tmp_path, above).suspects
+    assert "mm below the table's top level (less than 5 mm over it" in suspect.reason
+    assert suspect.reason.endswith("it holds the joint values of tower 3 height 1 on: a copied entry")
+
+
 def test_missing_entries_are_listed_and_the_rest_used(tmp_path: Path) -> None:
     rng = np.random.default_rng(5)
     q = rt.recorded_like(rt.stacked_station(rng), rng).q

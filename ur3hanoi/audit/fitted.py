@@ -177,6 +177,8 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
         v = judge_above(off_line, over_top, over_contact)
         if not in_limits[i]:
             v = Verdict("flagged", math.inf, "; ".join(x for x in (v.why, limits_why) if x))
+        if v.status == "flagged" and table.present[s[0], s[1], ON] and np.array_equal(qs[i], table.q[s[0], s[1], ON]):
+            v = replace(v, why=f"{v.why}; it holds the joint values of {pose_label(s[0], s[1], ON)}: a copied entry")
         shared = table.shared_with(s[0], s[1])
         if shared and v.why:
             v = replace(v, why=f"the above pose shared by heights {', '.join(str(h + 1) for h in shared)} of tower "
@@ -208,7 +210,7 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
                                   reason=e.reason) for e in chosen)
 
     notes, problem = _notes_and_problem(base, layout, sol.step, step_fitted, axis, rows, rule, len(c_idx),
-                                        int(checkable.sum()))
+                                        int(checkable.sum()), sol.origins)
     used = np.flatnonzero(fit.used)
     resid = (mc.p_world[used] - sol.points([c_slots[j] for j in used])) * 1e3
     rms = float(np.sqrt(np.mean(np.sum(resid**2, axis=1)))) if len(used) else math.nan
@@ -268,8 +270,8 @@ def _on_above_swaps(entries: dict[Slot, AuditEntry], rule: AuditRule) -> None:
 
 
 def _notes_and_problem(base: Station, layout: str, step: np.ndarray, step_fitted: bool, axis: np.ndarray,
-                       rows: tuple[AuditEntry, ...], rule: AuditRule, n_contacts: int, n_checkable: int
-                       ) -> tuple[list[str], str]:
+                       rows: tuple[AuditEntry, ...], rule: AuditRule, n_contacts: int, n_checkable: int,
+                       origins: np.ndarray) -> tuple[list[str], str]:
     notes = [_layout_note(base, layout, step, step_fitted)]
     off_vertical = float(angle_deg(axis.reshape(1, 3), np.array([0.0, 0.0, -1.0]))[0])
     if off_vertical > TILT_FLAG_DEG:
@@ -282,7 +284,19 @@ def _notes_and_problem(base: Station, layout: str, step: np.ndarray, step_fitted
                      f"is the only contact of its tower; record another height of tower(s) "
                      f"{', '.join(map(str, towers))} to check them")
     problem = ""
-    if n_checkable == 0:
+    block = base.block_size * 1e3
+    step_mm = float(np.linalg.norm(step)) * 1e3
+    gaps = [(a + 1, b + 1, float(np.linalg.norm((origins[a] - origins[b])[:2])) * 1e3)
+            for a in range(len(origins)) for b in range(a + 1, len(origins))]
+    close = [g for g in gaps if g[2] < block]
+    if step_fitted and step_mm < 0.5 * block:
+        problem = (f"the table's levels are {step_mm:.1f} mm apart (a block is {block:.1f} mm): its heights hold "
+                   "(nearly) the same pose. Copied entries? Re-record each height")
+    elif close:
+        a, b, d = close[0]
+        problem = (f"towers {a} and {b} stand {d:.1f} mm apart (a block is {block:.1f} mm): copied entries, or "
+                   "Q[tower] not in the lab's order? Re-record them")
+    elif n_checkable == 0:
         problem = ("no contact can be checked against the others (each tower has one contact, which alone fixes its "
                    "line): record at least two heights on every tower (all of them are best), then audit again")
     else:

@@ -216,8 +216,9 @@ class AuditReport:
             lines.append(f"the fit is not sound: {self.problem}")
         present = [e for e in self.entries if e.status != "missing"]
         ok = sum(e.status in ("ok", "warn", "unchecked") for e in present)
+        verdict = "; the table fails: it cannot be audited as it is" if self.problem else ""
         lines.append(f"{ok}/{len(present)} entries pass ({len(self.warnings)} with a warning, "
-                     f"{len(self.suspects)} flagged)")
+                     f"{len(self.suspects)} flagged){verdict}")
         return "\n".join(lines)
 
 

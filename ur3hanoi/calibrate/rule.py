@@ -224,6 +224,10 @@ def judge_contact(off_line_mm: float, off_level_mm: float, tilt_deg: float, rule
     return Verdict(status=status, severity=severity, why="; ".join(parts))
 
 
+def _over(mm: float) -> str:
+    return f"only {mm:.1f} mm over" if mm >= 0 else f"{-mm:.1f} mm below"
+
+
 def judge_above(off_line_mm: float, over_top_mm: float, over_contact_mm: float) -> Verdict:
     """An above pose's verdict from its distance off its contact's vertical line [mm] and its height over the
     table's top level and over its own contact level [mm] (tilt is not judged)."""
@@ -231,12 +235,12 @@ def judge_above(off_line_mm: float, over_top_mm: float, over_contact_mm: float) 
     severity = max(off_line_mm / ABOVE_FLAG_LINE_MM, 1.0 + (ABOVE_MIN_MM - low) / ABOVE_MIN_MM)
     flags, warns = [], []
     if over_top_mm < ABOVE_MIN_MM:
-        flags.append(f"only {over_top_mm:.1f} mm over the table's top level (less than {ABOVE_MIN_MM:g} mm: a "
-                     "carried block would hit a full stack)")
+        flags.append(f"{_over(over_top_mm)} the table's top level (less than {ABOVE_MIN_MM:g} mm over it: a carried "
+                     "block would hit a full stack)")
     elif over_top_mm < ABOVE_CLEAR_MM:
         warns.append(f"{over_top_mm:.1f} mm over the table's top level (less than {ABOVE_CLEAR_MM:g} mm)")
     if over_contact_mm < ABOVE_MIN_MM and over_contact_mm < over_top_mm:
-        flags.append(f"only {over_contact_mm:.1f} mm over its own contact (less than {ABOVE_MIN_MM:g} mm)")
+        flags.append(f"{_over(over_contact_mm)} its own contact (less than {ABOVE_MIN_MM:g} mm over it)")
     if off_line_mm > ABOVE_FLAG_LINE_MM:
         flags.append(f"{off_line_mm:.1f} mm off its contact's vertical line (more than {ABOVE_FLAG_LINE_MM:g} mm)")
     elif off_line_mm > ABOVE_LINE_MM:
