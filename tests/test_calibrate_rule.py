@@ -70,7 +70,7 @@ def test_above_poses() -> None:
     low = judge_above(0.0, ABOVE_MIN_MM - 0.5, ABOVE_MIN_MM - 0.5)
     assert low.status == "flagged" and "over the table's top level" in low.why
     under = judge_above(0.0, 30.0, -20.0)  # (a contact level above the top one cannot happen; its own rule holds)
-    assert under.status == "flagged" and "over its own contact" in under.why
+    assert under.status == "flagged" and "20.0 mm below its own contact" in under.why
 
 
 def test_the_table_axis_is_robust_to_a_tilted_entry() -> None:
