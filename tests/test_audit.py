@@ -312,7 +312,7 @@ def test_a_table_only_conditioning_stops_says_so(tmp_path: Path) -> None:
         "record at least two heights on every tower" in report.problem
 
 
-def test_copied_heights_or_towers_are_a_problem_not_a_fit(tmp_path: Path) -> None:
+def test_copied_or_reversed_heights_and_copied_towers_are_a_problem(tmp_path: Path) -> None:
     rng = np.random.default_rng(13)
     q = rt.recorded_like(rt.stacked_station(rng), rng).q
     same = q.copy()
@@ -323,6 +323,11 @@ def test_copied_heights_or_towers_are_a_problem_not_a_fit(tmp_path: Path) -> Non
     copied_tower = np.concatenate([q, q[:1]], axis=0)  # a fourth tower copied from the first
     report = _audit(tmp_path, copied_tower)
     assert report.failed and report.problem.startswith("towers 1 and 4 stand 0.0 mm apart")
+    reversed_heights = q[:, ::-1].copy()
+    report = _audit(tmp_path, reversed_heights)
+    assert report.failed and report.problem.startswith("the table's levels step 31.") and \
+        "mm down: height 1 (Q[tower][0]) must be the bottom block" in report.problem
+    assert report.suspects == ()  # the above poses are judged against the top of the stacks all the same
     above = q.copy()
     above[2, 0, ABOVE] = q[2, 0, ON]
     (suspect,) = _audit(tmp_path, above).suspects

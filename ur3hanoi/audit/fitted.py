@@ -132,7 +132,7 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
 
     entries: dict[Slot, AuditEntry] = {}
     verdicts: dict[Slot, Verdict] = {}
-    top_z = max(float(sol.point((t, n_h - 1, ON))[2]) for t in range(n_t))
+    top_z = max(float(sol.point((t, h, ON))[2]) for t in range(n_t) for h in range(n_h))  # the top of any stack
     field = {s: f"{table.key}[{s[0]}][{s[1]}][{s[2]}]" for s in slots}
     limits_why = (f"its joint angles are outside the joint limits of {printable(base.source)}: left out of the fit")
 
@@ -292,6 +292,9 @@ def _notes_and_problem(base: Station, layout: str, step: np.ndarray, step_fitted
     if step_fitted and step_mm < 0.5 * block:
         problem = (f"the table's levels are {step_mm:.1f} mm apart (a block is {block:.1f} mm): its heights hold "
                    "(nearly) the same pose. Copied entries? Re-record each height")
+    elif step_fitted and layout == "stacked" and step[2] < 0:
+        problem = (f"the table's levels step {step_mm:.1f} mm down: height 1 (Q[tower][0]) must be the bottom block "
+                   "and the last height the top one; reverse the heights")
     elif close:
         a, b, d = close[0]
         problem = (f"towers {a} and {b} stand {d:.1f} mm apart (a block is {block:.1f} mm): copied entries, or "
