@@ -144,11 +144,12 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
         else:
             v = judge_contact(0.0, 0.0, float(tilt[i]), rule)
             if v.status == "ok":
-                alone = ("the only contact of tower" if sum(c[0] == s[0] for c in c_slots) == 1 else
-                         "the only contact the fit keeps (the others are off) of tower")
-                v = Verdict("unchecked", 0.0, f"{alone} {s[0] + 1}: nothing else fixes its line, so its position "
-                                              f"cannot be checked (record another height of tower {s[0] + 1} to "
-                                              "check it)")
+                alone = (f"the only contact of tower {s[0] + 1}: nothing else fixes its line"
+                         if sum(c[0] == s[0] for c in c_slots) == 1 else
+                         f"the grid cannot be fitted without it (with the contacts kept, it alone fixes tower "
+                         f"{s[0] + 1}'s line or the step between levels)")
+                v = Verdict("unchecked", 0.0, f"{alone}, so its position cannot be checked (record another height "
+                                              f"of tower {s[0] + 1} to check it)")
         verdicts[s] = v
         entries[s] = AuditEntry(
             tower=s[0], height=s[1], k=s[2], field=field[s],
@@ -280,8 +281,8 @@ def _notes_and_problem(base: Station, layout: str, step: np.ndarray, step_fitted
     unchecked = [e for e in rows if e.status == "unchecked"]
     if unchecked:
         towers = sorted({e.tower + 1 for e in unchecked})
-        notes.append(f"{len(unchecked)} contact(s) cannot be checked ({', '.join(e.label for e in unchecked)}): each "
-                     f"is the only contact of its tower; record another height of tower(s) "
+        notes.append(f"{len(unchecked)} contact(s) cannot be checked ({', '.join(e.label for e in unchecked)}): the "
+                     f"grid cannot be fitted without each; record another height of tower(s) "
                      f"{', '.join(map(str, towers))} to check them")
     problem = ""
     block = base.block_size * 1e3
@@ -300,8 +301,9 @@ def _notes_and_problem(base: Station, layout: str, step: np.ndarray, step_fitted
         problem = (f"towers {a} and {b} stand {d:.1f} mm apart (a block is {block:.1f} mm): copied entries, or "
                    "Q[tower] not in the lab's order? Re-record them")
     elif n_checkable == 0:
-        problem = ("no contact can be checked against the others (each tower has one contact, which alone fixes its "
-                   "line): record at least two heights on every tower (all of them are best), then audit again")
+        problem = ("no contact can be checked against the others (each alone fixes its tower's line or the step "
+                   "between levels): record at least two heights on every tower (all of them are best), then audit "
+                   "again")
     else:
         off = [e for e in rows if e.k == ON and e.status == "suspect" and not math.isnan(e.off_line_mm)
                and math.hypot(e.off_line_mm, e.off_level_mm) > rule.flag_mm]
