@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -100,3 +101,123 @@ def table_doc(q: np.ndarray, contact_only: bool = False, missing: Sequence[Slot]
 def write_table(path: Path, key: str, doc: list[Any]) -> Path:
     path.write_text(yaml.safe_dump({key: doc}, sort_keys=False))
     return path
+
+
+# ------------------------------------------------------------------------------------- recorded-like tables
+#
+# What real hand-recorded tables look like (issue 19): the suction point is jogged onto each block within 1-2 mm,
+# the arm arrives at each tower with its own heading (and wrist 3 turned a little more or less per entry), the
+# suction axis is off vertical by the same small amount on the whole table (robot base or tool mount) plus a
+# fraction of a degree per entry, and the above poses are recorded anywhere 15-60 mm over the top of the stacks.
+
+JITTER_MM = (1.0, 2.0)
+"""[mm] how far a recorded suction point is from the block's (random direction)."""
+TOWER_HEADING_DEG = 30.0
+"""[deg] each tower's arrival heading is the station's tool yaw + U(-30, 30)."""
+WRIST3_DEG = 8.0
+"""[deg] each entry's heading is its tower's + U(-8, 8) (wrist 3 turned by eye)."""
+TABLE_TILT_DEG = 1.5
+"""[deg] the whole table's suction axis is off vertical by U(0, 1.5) in a random direction."""
+ENTRY_TILT_DEG = 0.7
+"""[deg] each entry's suction axis is off the table's by U(0, 0.7) in a random direction."""
+ABOVE_MM = (15.0, 60.0)
+"""[mm] an above pose is U(15, 60) over the table's top level (the top contact of the stacks)."""
+SPACINGS_M = (0.05, 0.15)
+"""[m] stacked stations: the gap between neighbouring towers, drawn per gap."""
+
+
+def _turn_to(axis_from: np.ndarray, axis_to: np.ndarray) -> np.ndarray:
+    """The smallest rotation taking unit vector ``axis_from`` to ``axis_to``."""
+    w = np.cross(axis_from, axis_to)
+    s = float(np.linalg.norm(w))
+    if s < 1e-12:
+        return np.eye(3)
+    return np.asarray(pin.exp3(w / s * math.atan2(s, float(axis_from @ axis_to))))
+
+
+def _tilted(rng: np.random.Generator, max_deg: float, exact_deg: float | None = None) -> np.ndarray:
+    """A rotation about a random horizontal axis by U(0, max_deg) (or ``exact_deg``)."""
+    a = rng.uniform(0.0, 2.0 * math.pi)
+    deg = rng.uniform(0.0, max_deg) if exact_deg is None else exact_deg
+    return np.asarray(pin.exp3(np.array([math.cos(a), math.sin(a), 0.0]) * math.radians(deg)))
+
+
+def stacked_station(rng: np.random.Generator) -> Station:
+    """A lab_real-like stacked station: three towers in a row along y at uneven gaps of 5-15 cm."""
+    from dataclasses import replace
+
+    from ur3hanoi.station import load_station
+
+    base = load_station("lab_real")
+    gaps = rng.uniform(*SPACINGS_M, size=base.n_towers - 1)
+    y = np.concatenate([[0.0], np.cumsum(gaps)])
+    y = y - y.mean() - 0.07 + rng.uniform(-0.02, 0.02)
+    x = rng.uniform(0.22, 0.30)
+    z = base.tower_origins[0][2] + rng.uniform(-0.002, 0.002)
+    return replace(base, tower_origins=tuple((float(x), float(yi), float(z)) for yi in y))
+
+
+def flat_station() -> Station:
+    """The course's flat Gazebo layout (lab_sim)."""
+    from ur3hanoi.station import load_station
+
+    return load_station("lab_sim")
+
+
+@dataclass(frozen=True)
+class RecordedLike:
+    """A recorded-like table: its station (the truth), joint values ``q`` (T, H, 2, 6) [rad], and the true suction
+    axis of the table (unit vector pointing down, world)."""
+
+    station: Station
+    q: np.ndarray
+    axis: np.ndarray
+
+
+def pose_q(station: Station, p_world: np.ndarray, R_world: np.ndarray) -> np.ndarray:
+    """Joint values [rad] (home's branch, nearest home) putting the suction point at ``p_world`` [m] with
+    orientation ``R_world`` (closed-form IK)."""
+    from ur3hanoi.ik import analytic_ik, branch_of, wrap_angle
+
+    robot = load_ur3(station.tool, station.limits)
+    home = station.q_home_array
+    branch = branch_of(home)
+    T_base_tool0 = station.T_world_base.actInv(pin.SE3(R_world, p_world)) * robot.T_tcp_tool0
+    sol = analytic_ik(T_base_tool0, only=branch)
+    if branch not in sol:
+        raise ValueError(f"pose {np.round(p_world, 4).tolist()} unreachable on home's branch")
+    return np.asarray(home + wrap_angle(sol[branch] - home))
+
+
+def R_tcp(heading: float, tilt_deg: float = 0.0, tilt_about: float = 0.0) -> np.ndarray:
+    """Suction axis tilted ``tilt_deg`` off straight down (about the horizontal axis at ``tilt_about`` [rad]), TCP x
+    along ``heading`` [rad]."""
+    from ur3hanoi.grid import R_world_tcp_down
+
+    turn = pin.exp3(np.array([math.cos(tilt_about), math.sin(tilt_about), 0.0]) * math.radians(tilt_deg))
+    return np.asarray(turn @ R_world_tcp_down(heading))
+
+
+def recorded_like(station: Station, rng: np.random.Generator, tilted: Slot | None = None,
+                  tilt_deg: tuple[float, float] = (5.0, 6.0)) -> RecordedLike:
+    """A table as a student records it on ``station`` (see the constants above); with ``tilted``, that entry's
+    suction axis is U(5, 6) deg off the table's (a real mistake) while its suction point is still on the block."""
+    from ur3hanoi.grid import R_world_tcp_down
+
+    table_tilt = _tilted(rng, TABLE_TILT_DEG)
+    axis = table_tilt @ np.array([0.0, 0.0, -1.0])
+    top = max(T_world_tcp(station, t, station.n_heights - 1, ON).translation[2] for t in range(station.n_towers))
+    q = np.empty((station.n_towers, station.n_heights, 2, 6))
+    for t in range(station.n_towers):
+        tower_heading = station.tool_yaw + math.radians(rng.uniform(-TOWER_HEADING_DEG, TOWER_HEADING_DEG))
+        for h in range(station.n_heights):
+            for k in (ON, ABOVE):
+                p = T_world_tcp(station, t, h, ON).translation.copy()
+                if k == ABOVE:
+                    p[2] = top + rng.uniform(*ABOVE_MM) * 1e-3
+                p = p + _unit(rng) * rng.uniform(*JITTER_MM) * 1e-3
+                heading = tower_heading + math.radians(rng.uniform(-WRIST3_DEG, WRIST3_DEG))
+                entry = (_tilted(rng, 0.0, rng.uniform(*tilt_deg)) if (t, h, k) == tilted
+                         else _tilted(rng, ENTRY_TILT_DEG))
+                q[t, h, k] = pose_q(station, p, entry @ table_tilt @ R_world_tcp_down(heading))
+    return RecordedLike(station=station, q=q, axis=axis)

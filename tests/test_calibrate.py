@@ -504,7 +504,7 @@ def test_cli_calibrate_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
                                str(LAB_REAL), "-o", str(out), "--json"], capsys)
     assert rc == 0 and out.exists()
     doc = json.loads(stdout)
-    assert set(doc) == {"entries", "suspects", "fit"} and doc["suspects"] == []
+    assert set(doc) == {"entries", "suspects", "warnings", "fit"} and doc["suspects"] == doc["warnings"] == []
     assert len(doc["entries"]) == 18 and doc["entries"][0]["field"] == "real_pos[0][0][0]"
     assert doc["fit"]["points_used"] == 18 and doc["fit"]["rms_mm"] < 1e-6
     assert err.startswith(f"wrote {out}: fitted ")

@@ -10,7 +10,8 @@ point::
 
     ur3hanoi calibrate --from-table lab2_data.yaml --key real_pos --base lab_real -o out.yaml
 
-The same fit audits a table on its own (``ur3hanoi check-table --fit``, :mod:`ur3hanoi.audit`).
+The same robust fit, on a table's contacts alone, audits a table on its own (``ur3hanoi check-table --fit``,
+:mod:`ur3hanoi.audit.fitted`), judging every entry by the rule of :mod:`~ur3hanoi.calibrate.rule`.
 
 Module map:
 
@@ -19,7 +20,9 @@ Module map:
 - :mod:`~ur3hanoi.calibrate.robust`: sequential leave-one-out deletion of gross errors, with suspect thresholds
   from the data's robust scatter (``max(3 mm, 5 sigma)``, ``max(2 deg, 5 sigma)``).
 - :mod:`~ur3hanoi.calibrate.explain`: why a pose is off (a typo in one joint, swapped or copied entries, a pose
-  recorded in the wrong slot).
+  recorded in the wrong slot); :func:`~ur3hanoi.calibrate.explain.diagnose_contacts` with the heading left free.
+- :mod:`~ur3hanoi.calibrate.rule`: the audit rule in mm and deg (contacts: never flagged within 5 mm / 4 deg,
+  always over 8 mm / 5 deg; above poses clear of the top level and on their contact's line).
 - :mod:`~ur3hanoi.calibrate.fit`: :func:`fit_station`, the :class:`CalibrationFit` result and its suspects.
 - :mod:`~ur3hanoi.calibrate.output`: the calibration file written (refused when the fit is not sound).
 

@@ -215,15 +215,132 @@ def diagnose(robot: Ur3Model, T_world_base: pin.SE3, slots: Sequence[Slot], qs: 
     return out
 
 
+# ------------------------------------------------------------------------------- heading-free (check-table --fit)
+
+
+def _tilt_after(robot: Ur3Model, T_world_base: pin.SE3, q: FloatArray, p_target: FloatArray, axis: FloatArray
+                ) -> tuple[float, float]:
+    T = T_world_base * robot.fk(q, "tcp")
+    dp = float(np.linalg.norm(T.translation - p_target)) * 1e3
+    dt = math.degrees(math.acos(float(np.clip(T.rotation[:, 2] @ axis, -1.0, 1.0))))
+    return dp, dt
+
+
+def joint_typo_point(robot: Ur3Model, T_world_base: pin.SE3, q: Sequence[float], p_target: FloatArray,
+                     axis: FloatArray, scale_mm: float, scale_deg: float) -> JointTypo | None:
+    """The single-joint change of ``q`` [rad] that best moves the suction point to ``p_target`` [m, world] and the
+    suction axis onto ``axis`` (unit vector, world), the heading about the axis left free; None when no change of
+    at least :data:`MIN_TYPO_DEG` helps. ``explains`` is left False: the caller decides (see
+    :func:`diagnose_contacts`). Errors are weighed by ``scale_mm`` and ``scale_deg``."""
+    q0 = np.asarray(q, dtype=float)
+    p_target = np.asarray(p_target, dtype=float)
+    T = T_world_base * robot.fk(q0, "tcp")
+    R = T.rotation
+    J = robot.frame_jacobian_local(q0, "tcp")
+    z = R[:, 2]
+    w = np.cross(z, axis)
+    s = float(np.linalg.norm(w))
+    turn = w / s * math.atan2(s, float(z @ axis)) if s > 1e-12 else np.zeros(3)  # world rotation: z onto axis
+    best: tuple[float, int, float, float, float] | None = None
+    for j in range(len(q0)):
+        u = R @ J[3:, j]
+        v = R @ J[:3, j]
+        lever = np.cross(v, u)
+        radius = float(np.linalg.norm(lever))
+        d = p_target - (T.translation - lever)
+        d_perp = d - u * float(u @ d)
+        candidates = [float(u @ turn)]
+        if radius > 1e-6 and float(np.linalg.norm(d_perp)) > 1e-9:
+            d_pos = math.atan2(float(u @ np.cross(lever, d_perp)), float(lever @ d_perp))
+            a_p, a_r = (radius * 1e3 / scale_mm) ** 2, (180.0 / math.pi / scale_deg) ** 2
+            candidates += [d_pos, (a_p * d_pos + a_r * candidates[0]) / (a_p + a_r)]
+        for delta in candidates:
+            if abs(math.degrees(delta)) < MIN_TYPO_DEG:
+                continue
+            qj = q0.copy()
+            qj[j] += delta
+            dp, dt = _tilt_after(robot, T_world_base, qj, p_target, axis)
+            cost = (dp / scale_mm) ** 2 + (dt / scale_deg) ** 2
+            if best is None or cost < best[0]:
+                best = (cost, j, float(delta), dp, dt)
+    if best is None:
+        return None
+    _, j, delta, dp, dt = best
+    return JointTypo(joint=j, recorded=float(q0[j]), predicted=float(q0[j] + delta), residual_mm=dp, residual_deg=dt,
+                     explains=False)
+
+
+TYPO_SHARE = 0.25
+"""A single-joint change is called a likely typo only when it leaves at most this share of the deviation (and at
+most the never-flagged distance and tilt): one joint explains most of a large error."""
+
+
+def diagnose_contacts(robot: Ur3Model, T_world_base: pin.SE3, slots: Sequence[Slot], qs: Sequence[Sequence[float]],
+                      p_world: FloatArray, tilt_deg: FloatArray, targets: FloatArray,
+                      grid_points: dict[Slot, FloatArray], suspects: Sequence[int], axis: FloatArray,
+                      flag_mm: float, flag_deg: float, ok_mm: float, ok_deg: float, labels: Sequence[str]
+                      ) -> dict[int, str]:
+    """What probably happened to each flagged contact, the heading about the suction axis left free: a copied
+    entry, two swapped entries, a pose recorded in another slot, or a typo in one joint when that one change
+    explains most of a large error (at most :data:`TYPO_SHARE` of it and ``ok_mm`` / ``ok_deg`` left); "" when
+    only the tilt is off.
+
+    Args:
+        slots, qs, p_world, tilt_deg: every contact's slot, joint values [rad], suction point [m, world] and axis
+            angle from the table's [deg].
+        targets: where the grid puts each contact [m, world], shape (N, 3).
+        grid_points: the grid's contact point of every slot.
+        suspects: indices of the contacts to explain.
+        axis: the table's suction axis; flag_mm, flag_deg: the flag thresholds; ok_mm, ok_deg: the never-flagged
+            ones.
+        labels: how each contact is named.
+    """
+    from ur3hanoi.waypoints import pose_label
+
+    dup = duplicates(slots, qs, [False] * len(slots))
+    swaps = find_swaps(slots, p_world, grid_points, suspects, flag_mm)
+    out: dict[int, str] = {}
+    for i in suspects:
+        err = float(np.linalg.norm(p_world[i] - targets[i])) * 1e3
+        if i in dup:
+            out[i] = f"it holds the joint values of {labels[dup[i]]}: a copied entry"
+        elif i in swaps:
+            j, di, dj = swaps[i]
+            out[i] = (f"{swap_kind(slots[i], slots[j])} with {labels[j]}: exchanged, both are within "
+                      f"{max(di, dj):.1f} mm of the grid")
+        elif err <= flag_mm:
+            out[i] = ""
+        else:
+            slot, d = nearest_slot(p_world[i], grid_points)
+            typo = joint_typo_point(robot, T_world_base, qs[i], targets[i], axis, ok_mm, ok_deg)
+            explains = (typo is not None and typo.residual_mm <= min(ok_mm, TYPO_SHARE * err)
+                        and typo.residual_deg <= ok_deg)
+            if slot != slots[i] and d <= flag_mm and tilt_deg[i] <= flag_deg and not (
+                    explains and typo is not None and typo.residual_mm < d):
+                out[i] = f"it is {d:.1f} mm from where the grid puts {pose_label(*slot)}: recorded in the wrong slot?"
+            elif explains and typo is not None:
+                out[i] = (f"likely {typo.describe()} (that one change leaves {typo.residual_mm:.1f} mm of the "
+                          f"{err:.1f} mm)")
+            elif typo is not None:
+                out[i] = (f"no single joint explains it (the best, joint {typo.joint + 1}, leaves "
+                          f"{typo.residual_mm:.1f} mm of {err:.1f} mm): re-record it")
+            else:
+                out[i] = "no single joint explains it: re-record it"
+    return out
+
+
 __all__ = [
     "JOINT_LABELS",
     "MIN_TYPO_DEG",
+    "TYPO_SHARE",
     "JointTypo",
     "angle_text",
     "diagnose",
+    "diagnose_contacts",
     "duplicates",
     "find_swaps",
     "joint_typo",
+    "joint_typo_point",
     "nearest_slot",
     "swap_kind",
 ]

@@ -118,11 +118,13 @@ def robust_sigma(lengths: FloatArray) -> float:
 
 
 def thresholds(dev_mm: FloatArray, rot_deg: FloatArray, tol_mm: float | None = None,
-               tol_deg: float | None = None) -> Thresholds:
+               tol_deg: float | None = None, mm_range: tuple[float, float] | None = None) -> Thresholds:
     """Thresholds from the deviations [mm] and orientation errors [deg] of the points in a fit (see the module
-    docstring); ``tol_mm`` / ``tol_deg`` given: used as they are."""
+    docstring); ``tol_mm`` / ``tol_deg`` given: used as they are. ``mm_range`` (floor, ceiling) [mm] replaces the
+    position floor :data:`MIN_SUSPECT_MM` and caps the threshold."""
     s_mm, s_deg = robust_sigma(dev_mm), robust_sigma(rot_deg)
-    mm = tol_mm if tol_mm is not None else max(MIN_SUSPECT_MM, 0.0 if math.isnan(s_mm) else SUSPECT_SIGMAS * s_mm)
+    lo, hi = mm_range if mm_range is not None else (MIN_SUSPECT_MM, math.inf)
+    mm = tol_mm if tol_mm is not None else min(max(lo, 0.0 if math.isnan(s_mm) else SUSPECT_SIGMAS * s_mm), hi)
     deg = tol_deg if tol_deg is not None else max(MIN_SUSPECT_DEG,
                                                   0.0 if math.isnan(s_deg) else SUSPECT_SIGMAS * s_deg)
     return Thresholds(mm=mm, deg=deg, sigma_mm=s_mm, sigma_deg=s_deg, derived=tol_mm is None or tol_deg is None)
@@ -164,7 +166,8 @@ class RobustFit:
 
 def _evaluate(base: Station, model: GridModel, slots: Sequence[Slot], m: Measured, used: BoolArray,
               candidates: BoolArray, tol_mm: float | None, tol_deg: float | None,
-              frozen: Thresholds | None = None) -> RobustFit:
+              frozen: Thresholds | None = None, angle_deg: FloatArray | None = None,
+              mm_range: tuple[float, float] | None = None) -> RobustFit:
     idx = np.flatnonzero(used)
     used_slots = [slots[i] for i in idx]
     solution = solve(base, model, used_slots, m.p_world[idx])
@@ -174,12 +177,12 @@ def _evaluate(base: Station, model: GridModel, slots: Sequence[Slot], m: Measure
     loo, can = leave_one_out(model, used_slots, m.p_world[idx], solution)
     deviation[idx[can]] = loo[can]
     removable[idx] = can
-    rot = rotation_error_deg(m.R_world, yaw)
+    rot = rotation_error_deg(m.R_world, yaw) if angle_deg is None else angle_deg
     dev_mm = np.linalg.norm(deviation, axis=1) * 1e3
     # The scale comes from every candidate, in the fit or not: the points of the fit alone are the closest ones
     # (after the trimmed start) and would understate it; the median ignores the gross errors among the others.
     checkable = candidates & (removable | ~used)
-    th = frozen or thresholds(dev_mm[checkable], rot[candidates], tol_mm, tol_deg)
+    th = frozen or thresholds(dev_mm[checkable], rot[candidates], tol_mm, tol_deg, mm_range)
     return RobustFit(solution=solution, yaw=yaw, used=used.copy(), removable=removable, deviation=deviation,
                      rot_deg=rot, thresholds=th)
 
@@ -205,14 +208,23 @@ class _Lts:
         return np.asarray(np.sum((self.p[idx] - sol.points([self.slots[i] for i in idx])) ** 2, axis=1))
 
     def elemental(self, order: np.ndarray) -> np.ndarray | None:
+        """Points taken in ``order`` while they add to the rank, until the subset determines the grid (None if the
+        candidates never do). The rank is followed with an orthonormal basis of the rows taken (Gram-Schmidt): the
+        design holds 0, 1 and small integers, so a new row either adds a unit-size direction or none."""
+        n_unknowns = self.model.n_unknowns
+        basis = np.zeros((0, n_unknowns))
         chosen: list[int] = []
-        rank = 0
         for i in order:
-            r = int(np.linalg.matrix_rank(self.A[self.rows([*chosen, i])]))
-            if r > rank:
+            grew = False
+            for row in self.A[3 * int(i):3 * int(i) + 3]:
+                rest = row - (basis @ row) @ basis
+                norm = float(np.linalg.norm(rest))
+                if norm > 1e-9:
+                    basis = np.vstack([basis, rest / norm])
+                    grew = True
+            if grew:
                 chosen.append(int(i))
-                rank = r
-                if rank == self.model.n_unknowns:
+                if len(basis) == n_unknowns:
                     return np.array(chosen)
         return None
 
@@ -247,10 +259,16 @@ class _Lts:
         h = min(n, (n + math.ceil(self.model.n_unknowns / 3) + 1) // 2)
         rng = np.random.default_rng(_SEED)
         found: dict[tuple[int, ...], tuple[float, GridSolution]] = {}
+        tried: set[tuple[int, ...]] = set()
         for _ in range(N_SUBSETS):
             subset = self.elemental(cand[rng.permutation(n)])
             if subset is None:
                 continue
+            # The same subset (drawn in another order) gives the same trimmed fit: concentrate it once.
+            drawn = tuple(sorted(int(i) for i in subset))
+            if drawn in tried:
+                continue
+            tried.add(drawn)
             objective, keep, sol = self.concentrate(self.fit(subset), cand, h, _C_STEPS)
             key = tuple(int(i) for i in keep)
             if key not in found or objective < found[key][0]:
@@ -265,11 +283,15 @@ class _Lts:
 
 
 def robust_fit(base: Station, model: GridModel, slots: Sequence[Slot], m: Measured, candidates: BoolArray,
-               tol_mm: float | None = None, tol_deg: float | None = None) -> RobustFit:
+               tol_mm: float | None = None, tol_deg: float | None = None, angle_deg: FloatArray | None = None,
+               mm_range: tuple[float, float] | None = None) -> RobustFit:
     """Fit ``model`` to the ``candidates`` among the points measured at ``slots``, leaving out gross errors
     (see the module docstring).
 
     ``candidates`` must determine ``model``. ``tol_mm`` / ``tol_deg`` replace the derived thresholds.
+    ``angle_deg`` (N,) replaces the orientation error judged with each point (default: its angle from the grid
+    pose, heading included); zeros judge positions only (the audit checks the suction axis on its own).
+    ``mm_range`` (floor, ceiling) [mm] bounds the derived position threshold instead of the floor alone.
     """
     cand = np.flatnonzero(candidates)
     starts = _Lts(base, model, slots, m.p_world).starts(cand) if 3 * len(cand) > model.n_unknowns else [cand]
@@ -279,30 +301,33 @@ def robust_fit(base: Station, model: GridModel, slots: Sequence[Slot], m: Measur
         used[idx] = True
         return used
 
+    def evaluate(used: BoolArray) -> RobustFit:
+        return _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, None, angle_deg, mm_range)
+
     # Every start is grown and pruned under the same thresholds (those of the best trimmed fit), so that "more
     # points agree" compares like with like; the winner is then refined with the thresholds of its own fit.
     # Thresholds stay fixed while a fit grows and shrinks: re-estimating them after every change could swing a
     # point in and out.
-    frozen = _evaluate(base, model, slots, m, mask(starts[0]), candidates, tol_mm, tol_deg).thresholds
+    frozen = evaluate(mask(starts[0])).thresholds
     best: RobustFit | None = None
     for start in starts:
-        fit = _grow_and_prune(base, model, slots, m, mask(start), candidates, tol_mm, tol_deg, frozen)
+        fit = _grow_and_prune(base, model, slots, m, mask(start), candidates, tol_mm, tol_deg, frozen, angle_deg)
         if best is None or int(fit.used.sum()) > int(best.used.sum()):
             best = fit  # on a tie the earlier start: the better trimmed fit
     assert best is not None
-    frozen = _evaluate(base, model, slots, m, best.used, candidates, tol_mm, tol_deg).thresholds
-    fit = _grow_and_prune(base, model, slots, m, best.used, candidates, tol_mm, tol_deg, frozen)
-    return replace(_evaluate(base, model, slots, m, fit.used, candidates, tol_mm, tol_deg), thresholds=frozen)
+    frozen = evaluate(best.used).thresholds
+    fit = _grow_and_prune(base, model, slots, m, best.used, candidates, tol_mm, tol_deg, frozen, angle_deg)
+    return replace(evaluate(fit.used), thresholds=frozen)
 
 
 def _grow_and_prune(base: Station, model: GridModel, slots: Sequence[Slot], m: Measured, used: BoolArray,
-                    candidates: BoolArray, tol_mm: float | None, tol_deg: float | None, frozen: Thresholds
-                    ) -> RobustFit:
+                    candidates: BoolArray, tol_mm: float | None, tol_deg: float | None, frozen: Thresholds,
+                    angle_deg: FloatArray | None = None) -> RobustFit:
     """Step 3 of the module docstring, from the points ``used``, with the thresholds ``frozen``."""
     n_cand = int(candidates.sum())
     max_left_out = (n_cand - 1) // 2
     used = used.copy()
-    fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen)
+    fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen, angle_deg)
     for _ in range(4 * n_cand + 4):
         outside = np.where(candidates & ~used, fit.severity, np.inf)
         inside = np.where(used & fit.removable, fit.severity, -np.inf)
@@ -313,7 +338,7 @@ def _grow_and_prune(base: Station, model: GridModel, slots: Sequence[Slot], m: M
             used[drop] = False
         else:
             break
-        fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen)
+        fit = _evaluate(base, model, slots, m, used, candidates, tol_mm, tol_deg, frozen, angle_deg)
     return fit
 
 

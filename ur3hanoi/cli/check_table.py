@@ -13,15 +13,18 @@ from ur3hanoi.labfile import TABLE_KEYS
 
 def add(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("check-table", help="audit a lab-format table: against a calibration, or its own fitted grid",
-                       description="Report, for every Q[tower][height][k] of FILE, the FK position [mm], orientation "
-                                   "and tilt [deg] error of the suction point against a reference, the missing "
-                                   "entries, and the suspect entries worst first with what probably happened (a "
-                                   "typo in one joint, swapped or copied entries). The reference is a calibration's "
-                                   "intended poses (--calibration; default tolerance 1 mm / 0.5 deg, for generated "
-                                   "tables) or the station grid fitted robustly to the table itself (--fit; "
-                                   "thresholds from the data's own scatter, max(3 mm, 5 sigma) / max(2 deg, 5 "
-                                   "sigma), for hand-recorded tables). Towers and heights are numbered from 1. Exit "
-                                   "1 if any entry is suspect.")
+                       description="Report, for every Q[tower][height][k] of FILE, how far its suction point [mm] "
+                                   "and axis [deg] are from a reference, the missing entries, and the flagged "
+                                   "entries worst first with what probably happened (a typo in one joint, swapped or "
+                                   "copied entries). The reference is a calibration's intended poses (--calibration; "
+                                   "default tolerance 1 mm / 0.5 deg, for generated tables) or the station grid "
+                                   "fitted robustly to the table's own contacts (--fit, for hand-recorded tables): a "
+                                   "contact within 5 mm of its tower's line and its level, axis within 4 deg of the "
+                                   "table's, is never flagged; more than 8 mm from where the fit puts it or 5 deg "
+                                   "tilted always is; in between at most a warning; the heading about the suction "
+                                   "axis is never judged; an above pose must be 10 mm over the top level (flagged "
+                                   "under 5 mm) and within 8 mm of its contact's line (flagged over 10 mm). Towers "
+                                   "and heights are numbered from 1. Exit 1 if any entry is flagged.")
     p.add_argument("file", help="lab-format YAML (generated or hand-recorded; null or left-out entries allowed)")
     p.add_argument("--key", required=True, choices=TABLE_KEYS, help="table key")
     ref = p.add_mutually_exclusive_group(required=True)
@@ -31,12 +34,15 @@ def add(sub: argparse._SubParsersAction) -> None:
                      help="audit the table on its own: fit the station grid to its entries robustly")
     p.add_argument("--base", metavar="CALIBRATION",
                    help="with --fit: the calibration giving robot base, tool and home (default lab_sim for "
-                        "sim_pos, lab_real for real_pos)")
+                        "sim_pos, lab_real for real_pos; the layout, flat or stacked, is read off the table)")
     p.add_argument("--tol-mm", type=option(TOL_MM), default=None,
-                   help=f"{TOL_MM.expected()} (default 1 with --calibration, derived from the data with --fit)")
+                   help=f"{TOL_MM.expected()} (default 1 with --calibration; with --fit it replaces the 8 mm a "
+                        "contact is flagged over)")
     p.add_argument("--tol-deg", type=option(TOL_DEG), default=None,
-                   help=f"{TOL_DEG.expected()} (default 0.5 with --calibration, derived from the data with --fit)")
-    p.add_argument("--json", action="store_true", help="print one JSON object: entries, suspects, fit")
+                   help=f"{TOL_DEG.expected()} (default 0.5 with --calibration; with --fit it replaces the 5 deg "
+                        "a contact's axis is flagged over)")
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object: entries, suspects, warnings, fit (with --fit: the rule's thresholds)")
     p.set_defaults(func=run)
 
 
