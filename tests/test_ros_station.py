@@ -120,3 +120,31 @@ def test_frames_render_in_a_separate_process_and_duration_stops_the_station(tmp_
     assert len(list(frames.glob("frame_*.png"))) == data["frames"]["rendered"]
     assert data["control"]["cycles"] >= 0.5 * 3.0 * 125  # the loop ran (timing itself: bench/bench_ros.py)
     assert "ros-station stopped: 0 commands executed, 0 refused" in result.stdout
+
+
+def test_a_flood_of_valid_commands_keeps_the_rate_and_bounds_log_and_report(tmp_path):
+    """1 kHz of valid commands for 4 s: ur3/position keeps coming (today the loop stalled up to 1.83 s), the log
+    holds about one line per second, the report stays small (timing figures: bench/bench_ros.py --flood)."""
+    env = ros_env(free_port(), tmp_path)
+    near = {"destination": [HOME[0] + 0.05, *HOME[1:]], "v": 4.0, "a": 4.0, "io_0": False}
+    home = {"destination": HOME, "v": 4.0, "a": 4.0, "io_0": False}
+    seconds = 4.0
+    with roscore(env), station(env, tmp_path) as st:
+        lines_before = len(st.stderr)
+        result = run([sys.executable, str(TESTS / "ros_publisher.py"), "--flood", "1000", str(seconds),
+                      json.dumps([near, home])], env, 60.0)
+        assert result.returncode == 0, result.stderr
+        flood = json.loads(result.stdout.splitlines()[-1])
+        lines_during = len(st.stderr) - lines_before
+        report = st.stop()
+    assert flood["sent"] >= 0.9 * 1000 * seconds
+    assert flood["positions"] >= 0.5 * 125 * seconds
+    assert flood["max_gap_s"] < 0.25, flood  # 2 periods is the target; this bounds a stall on any shared CPU
+    assert lines_during <= seconds + 3, "".join(st.stderr[lines_before:][:5])
+    c = report["commands"]
+    assert c["executed"] + c["rejected"] + c["queued"] == flood["sent"]
+    assert c["executed"] > 0 and c["rejected"] > 0
+    assert len(report["executed"]) <= 100 and len(report["rejected"]) <= 100
+    assert st.report_path.stat().st_size < 100_000
+    logs = list((Path(env["ROS_HOME"]) / "log").rglob("ur3hanoi_station*.log"))
+    assert logs and sum(p.stat().st_size for p in logs) < 20_000
