@@ -62,8 +62,8 @@ class Station:
         self.stdout: list[str] = []
         self.stderr: list[str] = []
         self._ready = threading.Event()
-        self._threads = [threading.Thread(target=self._pump, args=(proc.stdout, self.stdout, True), daemon=True),
-                         threading.Thread(target=self._pump, args=(proc.stderr, self.stderr, False), daemon=True)]
+        self._threads = [threading.Thread(target=self._pump, args=(proc.stdout, self.stdout, False), daemon=True),
+                         threading.Thread(target=self._pump, args=(proc.stderr, self.stderr, True), daemon=True)]
         for t in self._threads:
             t.start()
 

@@ -59,29 +59,43 @@ def test_lab_style_program_solves_against_the_station(tmp_path):
 def test_malformed_commands_are_refused_with_a_logged_error_and_no_motion(tmp_path):
     env = ros_env(free_port(), tmp_path)
     cmd = "/ur3/command"
+    near = [HOME[0] + 0.2, *HOME[1:]]
     bad = [
         [cmd, "command", {"destination": HOME[:5], "v": 1.0, "a": 1.0, "io_0": True}],
         [cmd, "command", {"destination": [*HOME[:2], math.nan, *HOME[3:]], "v": 1.0, "a": 1.0, "io_0": True}],
         [cmd, "command", {"destination": [7.0, *HOME[1:]], "v": 1.0, "a": 1.0, "io_0": True}],
         [cmd, "command", {"destination": HOME, "v": 0.0, "a": 1.0, "io_0": True}],
+        [cmd, "command", {"destination": near, "v": 1e-9, "a": 1e-9, "io_0": True}],  # a 2e4 s move: refused
         [cmd, "String", {"data": "movej([0, 0, 0, 0, 0, 0])"}],  # unknown message type: never connected
     ]
     with roscore(env), station(env, tmp_path) as st:
         publish(env, bad)
+        snap = st.snapshot()
+        publish(env, [[cmd, "command", {"destination": near, "v": 4.0, "a": 4.0, "io_0": False}]])  # runs
+        for _ in range(100):
+            if (now := st.snapshot())["final"]["ready"] and now["commands"]["executed"] == 1:
+                break
         report = st.stop()
     reasons = [r["reason"] for r in report["rejected"]]
-    assert reasons == [
+    assert reasons[:4] == [
         "destination has 5 values: expected 6 joint angles [rad]",
         "destination[2] = nan is invalid: expected a finite angle [rad]",
         "destination[0] = 7.0 rad is outside joint 1's limits: expected -6.28319 <= q <= 6.28319 rad",
         "v = 0.0 is invalid: expected a finite number > 0 [rad/s]",
     ]
+    assert len(reasons) == 5
+    assert reasons[4].startswith("the move would take 2") and "expected at most 60 s (raise v or a)" in reasons[4]
     log = st.log()
-    for reason in reasons:
-        assert f"ur3/command rejected, the arm does not move: {reason}" in log
-    assert report["executed"] == [] and report["suction_events"] == []
-    assert max(abs(a - b) for a, b in zip(report["final"]["q"], HOME, strict=True)) < 1e-6
-    assert report["final"]["ready"] and not report["final"]["suction_on"]
+    prefix = "ur3/command rejected, the arm does not move: "
+    assert f"{prefix}{reasons[0]}" in log  # the first at once, the others summarised within a second
+    for reason in reasons[1:]:
+        assert f"1 x {reason}" in log
+    assert sum(prefix in line for line in st.stderr) == 2
+    assert snap["executed"] == [] and snap["suction_events"] == []
+    assert max(abs(a - b) for a, b in zip(snap["final"]["q"], HOME, strict=True)) < 1e-6
+    assert snap["final"]["ready"] and not snap["final"]["suction_on"]
+    assert report["commands"]["executed"] == 1  # the station still moves after the refusals
+    assert max(abs(a - b) for a, b in zip(report["final"]["q"], near, strict=True)) < 5e-4
 
 
 def test_spawn_and_remove_topics_own_roscore_and_reports(tmp_path):
