@@ -5,15 +5,24 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import shlex
+import signal
+import socket
+import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
 
 from tests.ros_support import (
+    Station,
+    alive,
+    descendants,
     final_slots,
     free_port,
+    listening_addresses,
     requires_ros,
     ros_env,
     roscore,
@@ -162,3 +171,77 @@ def test_a_flood_of_valid_commands_keeps_the_rate_and_bounds_log_and_report(tmp_
     assert st.report_path.stat().st_size < 100_000
     logs = list((Path(env["ROS_HOME"]) / "log").rglob("ur3hanoi_station*.log"))
     assert logs and sum(p.stat().st_size for p in logs) < 20_000
+
+
+def own_roscore_env(tmp_path: Path) -> dict[str, str]:
+    """A test's environment without ROS_IP/ROS_HOSTNAME (the station's defaults decide) and its own TMPDIR."""
+    env = {k: v for k, v in ros_env(free_port(), tmp_path).items() if k not in ("ROS_IP", "ROS_HOSTNAME")}
+    (tmp_path / "tmp").mkdir()
+    env["TMPDIR"] = str(tmp_path / "tmp")
+    return env
+
+
+def test_station_and_its_roscore_listen_on_loopback_only(tmp_path):
+    env = own_roscore_env(tmp_path)
+    with station(env, tmp_path) as st:
+        pids = {st.proc.pid, *descendants(st.proc.pid)}
+        listening = listening_addresses(pids)
+        st.stop()
+    port = int(env["ROS_MASTER_URI"].rsplit(":", 1)[1])
+    assert port in {p for _, p in listening}  # the roscore's master is among them
+    assert len(listening) >= 3, listening  # the master, the station's XML-RPC and TCPROS servers
+    assert {a for a, _ in listening} == {"127.0.0.1"}, listening
+
+
+def test_sigkill_of_the_station_leaves_no_process_and_no_log_behind(tmp_path):
+    env = own_roscore_env(tmp_path)
+    uri = env["ROS_MASTER_URI"]
+    with station(env, tmp_path) as st:
+        below = descendants(st.proc.pid)
+        assert master_answers(uri) and len(below) >= 2  # the guard and rosmaster
+        assert list((tmp_path / "tmp").glob("ur3hanoi-roscore-*"))
+        os.kill(st.proc.pid, signal.SIGKILL)  # the station alone: its children must follow by themselves
+        st.proc.wait(timeout=10)
+        deadline = time.monotonic() + 30.0
+        while any(alive(p) for p in below) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        left = [p for p in below if alive(p)]
+        for p in left:
+            os.kill(p, signal.SIGKILL)
+    assert left == []
+    assert not master_answers(uri)
+    assert list((tmp_path / "tmp").iterdir()) == []
+    assert not list(Path(env["ROS_HOME"]).rglob("master.log"))
+
+
+def test_a_master_that_accepts_connections_and_never_answers_fails_at_once(tmp_path):
+    env = ros_env(free_port(), tmp_path)
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen(16)
+        uri = f"http://127.0.0.1:{server.getsockname()[1]}"
+        # The listen backlog accepts the connections; nothing ever reads or answers (today: 51.8 s until an error).
+        result = run(ur3hanoi_cmd("ros-station", "--master", uri, "--duration", "1"), env, 20.0)
+    assert result.returncode == 2, result.stdout + result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, lines
+    assert lines[0].startswith(f"ur3hanoi: error: something at {uri} accepts connections but is not a ROS master")
+    assert result.stdout == ""
+
+
+def test_standard_output_carries_only_the_json_report(tmp_path):
+    env = ros_env(free_port(), tmp_path)
+    proc = subprocess.Popen(ur3hanoi_cmd("ros-station"), env=env, text=True, stdin=subprocess.DEVNULL,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    st = Station(proc, tmp_path / "unused.json")
+    try:
+        st.wait_ready()
+        publish(env, [["/ur3hanoi/spawn", "Int32", {"data": 2}]])  # rospy's loginfo wrote to stdout
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=30) == 0
+    finally:
+        st.kill()
+    report = json.loads("".join(st.stdout))
+    assert [s["tower"] for s in report["spawns"]] == [1, 2]
+    err = "".join(st.stderr)
+    assert "ur3hanoi ros-station: ready" in err and "ur3hanoi/spawn: 3 blocks respawned on tower 2" in err

@@ -63,15 +63,15 @@ def import_std_msgs() -> ModuleType:
     return importlib.import_module("std_msgs.msg")
 
 
-def roscore_executable() -> str:
-    """Path of ``roscore``.
+def roscore_executable(name: str = "roscore") -> str:
+    """Path of ``roscore`` (or another program of package ``ros-core``, e.g. ``rosmaster``).
 
     Raises:
         RosUnavailableError: not on PATH (package ``ros-core`` missing).
     """
-    path = shutil.which("roscore")
+    path = shutil.which(name)
     if path is None:
-        raise RosUnavailableError(f"roscore is not on PATH: {_INSTALL_HINT}")
+        raise RosUnavailableError(f"{name} is not on PATH: {_INSTALL_HINT}")
     return path
 
 

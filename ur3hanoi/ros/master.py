@@ -6,9 +6,14 @@ registered too; on exit the guard stops it (SIGINT, the way roscore wants to be 
 The guard also does so when the station dies, even by SIGKILL, and the roscore's logs live in a temporary folder
 the guard removes. A master that already answers is used and left running.
 
-Listening: the roscore started here binds and advertises ``host`` (``ROS_IP``; default ``127.0.0.1``, loopback
-only; any other address binds all interfaces, as rosgraph does). A port where something accepts connections but
-does not answer like a master within :data:`PROBE_TIMEOUT_S` is an error at once (no roscore is started there).
+Listening: the master started here binds and advertises ``host`` (``ROS_IP``; default ``127.0.0.1``, loopback
+only; any other address binds all interfaces, as rosgraph does). On loopback it is ``rosmaster --core`` alone, the
+master roscore would run, without roscore's ``rosout`` node: rosout's C++ XML-RPC server (xmlrpcpp) listens on
+every interface whatever ``ROS_IP`` says (measured), and nothing the lab uses needs it (nodes log to their stderr
+and log files; ``/rosout`` simply has no subscriber). With another ``host`` the full ``roscore`` runs.
+
+A port where something accepts connections but does not answer like a master within :data:`PROBE_TIMEOUT_S` is
+an error at once (no roscore is started there).
 """
 
 from __future__ import annotations
@@ -48,9 +53,13 @@ def is_loopback(host: str) -> bool:
 
 
 def listen_env(env: dict[str, str], host: str) -> dict[str, str]:
-    """``env`` with ``ROS_IP=host`` and no ``ROS_HOSTNAME`` (rosgraph prefers ROS_IP; loopback binds 127.0.0.1)."""
+    """``env`` with ``ROS_IP=host``: Python nodes (rosgraph prefers ROS_IP) bind a loopback ``host`` only, any
+    other address on all interfaces. For a loopback ``host`` also ``ROS_HOSTNAME=localhost``, which the C++ nodes
+    (roscpp: rosout) read first and take as "loopback only"; otherwise no ``ROS_HOSTNAME``."""
     out = {k: v for k, v in env.items() if k != "ROS_HOSTNAME"}
     out["ROS_IP"] = host
+    if is_loopback(host):
+        out["ROS_HOSTNAME"] = "localhost"
     return out
 
 
@@ -183,9 +192,14 @@ class RosCore:
         """The temporary folder of the roscore's logs (removed when it stops), or None."""
         return self._log_dir
 
+    @property
+    def with_rosout(self) -> bool:
+        """True when the full ``roscore`` (with ``rosout``) is started: ``host`` is not loopback."""
+        return not is_loopback(self.host)
+
     def start(self) -> RosCore:
-        """Start ``roscore`` unless a master answers. Raises RosError when it does not answer in time, or
-        something else holds the port."""
+        """Start ``roscore`` (``rosmaster`` on loopback) unless a master answers. Raises RosError when it does
+        not answer in time, or something else holds the port."""
         from ur3hanoi.ros.guard import make_log_dir, remove_stale_log_dirs
 
         if probe_master(self.uri) is not None:
@@ -193,14 +207,15 @@ class RosCore:
         if not self.master.is_local:
             raise RosError(f"no ROS master answers at {self.uri} and its host {self.master.host!r} is not this "
                            "machine: start roscore there, or set ROS_MASTER_URI to http://localhost:PORT")
-        exe = roscore_executable()
+        exe = roscore_executable("roscore" if self.with_rosout else "rosmaster")
+        args = [exe, "-p", str(self.master.port)] if self.with_rosout else [exe, "--core", "-p", str(self.master.port)]
         remove_stale_log_dirs()
         self._log_dir = make_log_dir()
         env = listen_env(dict(os.environ, ROS_MASTER_URI=self.uri), self.host)
         # The guard (own session: a Ctrl-C in the terminal reaches the station first, which then stops roscore in
         # order) reads the pipe on its stdin: end of file, when this process closes it or dies, stops roscore.
         self._guard = subprocess.Popen(
-            [sys.executable, "-m", "ur3hanoi.ros.guard", str(self._log_dir), "--", exe, "-p", str(self.master.port)],
+            [sys.executable, "-m", "ur3hanoi.ros.guard", str(self._log_dir), "--", *args],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env,
             start_new_session=True, bufsize=0)
         self.started = True
@@ -208,7 +223,8 @@ class RosCore:
         while time.monotonic() < deadline:
             self._read_guard()
             # Up when rosout has registered too: roscore ignores a SIGINT that arrives while it still launches it.
-            if self._pid is not None and node_registered(self.uri, "/rosout", timeout=0.5):
+            if self._pid is not None and (node_registered(self.uri, "/rosout", timeout=0.5) if self.with_rosout
+                                          else master_answers(self.uri, timeout=0.5)):
                 return self
             if self._exit is not None or self._guard.poll() is not None:
                 break

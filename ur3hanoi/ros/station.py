@@ -326,8 +326,9 @@ class RosStation:
             with RosCore(self.master_uri, host=self.options.host) as core:
                 self.roscore_started = core.started
                 # rospy reads these from the environment: the master, and the address to bind and advertise.
-                os.environ.update(listen_env(dict(os.environ, ROS_MASTER_URI=self.master_uri), self.options.host))
+                env = listen_env(dict(os.environ, ROS_MASTER_URI=self.master_uri), self.options.host)
                 os.environ.pop("ROS_HOSTNAME", None)
+                os.environ.update(env)
                 rospy.init_node("ur3hanoi_station", argv=[sys.argv[0]], disable_signals=True)
                 pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
                 pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
