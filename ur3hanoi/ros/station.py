@@ -201,7 +201,8 @@ class RosStation:
             with self._overflow_lock:
                 self._overflow[kind] = self._overflow.get(kind, 0) + 1
 
-    def _on_command(self, msg: Any) -> None:
+    def on_command(self, msg: Any) -> None:
+        """The ``ur3/command`` callback (any thread): the message waits in the inbox for :meth:`cycle`."""
         self._offer("command", msg)
 
     def _on_spawn(self, msg: Any) -> None:
@@ -250,6 +251,11 @@ class RosStation:
                 else:
                     self.log.log(_TOPIC_LOG[kind], "error", f"block {payload!r} is invalid: expected 1..{n}")
         self.log.flush()
+
+    def cycle(self) -> None:
+        """One control period of the node, without ROS: handle the inbox, then one driver and world step."""
+        self._drain()
+        self.driver.cycle()
 
     def _signal(self, signum: int, _frame: FrameType | None) -> None:
         if signum == signal.SIGUSR1:
@@ -332,7 +338,7 @@ class RosStation:
                 rospy.init_node("ur3hanoi_station", argv=[sys.argv[0]], disable_signals=True)
                 pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
                 pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
-                rospy.Subscriber("/ur3/command", msgs.command, self._on_command, queue_size=100)
+                rospy.Subscriber("/ur3/command", msgs.command, self.on_command, queue_size=100)
                 rospy.Subscriber("/ur3hanoi/spawn", std_msgs.Int32, self._on_spawn, queue_size=10)
                 rospy.Subscriber("/ur3hanoi/remove_block", std_msgs.Int32, self._on_remove, queue_size=10)
                 try:
@@ -374,8 +380,7 @@ class RosStation:
         while not self._stop and not self._rospy.is_shutdown():
             now = time.perf_counter()
             self.timing.add(now - next_t)
-            self._drain()
-            self.driver.cycle()
+            self.cycle()
             fb = w.feedback()
             pub_pos.publish(msgs.position(position=[float(x) for x in w.q], isReady=self.driver.ready))
             pub_grip.publish(msgs.gripper_input(DIGIN=fb.digin, AIN0=fb.ain0, AIN1=0.0))
