@@ -127,6 +127,7 @@ def flood_once(tmp: Path, seconds: float) -> dict[str, Any]:
     c, ctl = data["commands"], data["control"]
     received = c["executed"] + c["rejected"] + c["queued"]
     return {"seconds": seconds, "sent": flood["sent"], "received": received, "executed": c["executed"],
+            "positions": flood["positions"],
             "max_gap_ms": 1e3 * flood["max_gap_s"], "late": ctl["late_cycles"],
             "worst_lag_ms": 1e3 * ctl["worst_lag_s"],
             "lines_per_s": (lines1 - lines0) / flood["seconds"], "report_bytes": report.stat().st_size,
@@ -141,10 +142,11 @@ def main_flood(seconds: float) -> int:
         for s in (seconds / 4.0, seconds):
             rows.append(flood_once(tmp, s))
     print("ur3/command flood at 1 kHz (valid commands alternating two poses) against ur3hanoi ros-station, 125 Hz")
-    print(f"{'flood [s]':>9} {'sent':>6} {'recv':>6} {'exec':>5} {'max pos gap [ms]':>16} {'late':>5} "
+    print(f"{'flood [s]':>9} {'sent':>6} {'recv':>6} {'exec':>5} {'positions':>9} {'max pos gap [ms]':>16} {'late':>5} "
           f"{'worst lag [ms]':>14} {'log lines/s':>11} {'report [B]':>10} {'RSS +[kB]':>9} {'B/cmd':>6}")
     for r in rows:
-        print(f"{r['seconds']:>9.1f} {r['sent']:>6} {r['received']:>6} {r['executed']:>5} {r['max_gap_ms']:>16.1f} "
+        print(f"{r['seconds']:>9.1f} {r['sent']:>6} {r['received']:>6} {r['executed']:>5} {r['positions']:>9} "
+              f"{r['max_gap_ms']:>16.1f} "
               f"{r['late']:>5} {r['worst_lag_ms']:>14.1f} {r['lines_per_s']:>11.2f} {r['report_bytes']:>10} "
               f"{r['rss_growth_kb']:>9} {r['bytes_per_cmd']:>6.1f}")
     last = rows[-1]

@@ -58,7 +58,7 @@ def flood(rate_hz: float, seconds: float, fields: list[dict[str, Any]]) -> int:
     t1 = time.perf_counter()
     time.sleep(0.5)
     during = [t for t in stamps if t0 <= t <= t1]
-    gaps = [b - a for a, b in itertools.pairwise(during)]
+    gaps = [b - a for a, b in itertools.pairwise([t0, *during, t1])]  # a station that stops publishing shows
     print(json.dumps({"sent": sent, "seconds": round(t1 - t0, 3), "positions": len(during),
                       "max_gap_s": round(max(gaps), 6) if gaps else None}), flush=True)
     rospy.signal_shutdown("done")

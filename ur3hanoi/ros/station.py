@@ -326,6 +326,10 @@ class RosStation:
         std_msgs = import_std_msgs()
         handled = (signal.SIGINT, signal.SIGTERM, signal.SIGUSR1)
         previous = {s: signal.signal(s, self._signal) for s in handled}
+        # rospy's receiving threads hold the GIL for each message they decode: with the default 5 ms switch
+        # interval a flood of messages can keep the control loop waiting most of an 8 ms period.
+        switch = sys.getswitchinterval()
+        sys.setswitchinterval(min(switch, 0.0005))
         sink: Any = None
         try:
             sink = self._sink = self._open_sink()  # before rospy starts its threads
@@ -355,6 +359,7 @@ class RosStation:
                 sink.close()
             for s, handler in previous.items():
                 signal.signal(s, handler)
+            sys.setswitchinterval(switch)
         return report
 
     def _open_sink(self) -> Any:
