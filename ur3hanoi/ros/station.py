@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import bisect
 import gc
+import ipaddress
 import json
 import math
 import os
@@ -174,6 +175,11 @@ class RosStation:
         self.driver = StationDriver(self.world)
         self.master_uri = opts.master_uri or master_uri_from_env()
         master = MasterUri.parse(self.master_uri)
+        try:
+            ipaddress.ip_address(opts.host)
+        except ValueError:
+            raise RosError(f"host {opts.host!r} is invalid: expected this machine's IP address (ROS_IP), e.g. "
+                           "127.0.0.1 (default, this machine only) or its address on the lab network") from None
         if not master.is_local and is_loopback(opts.host):
             raise RosError(f"the ROS master {self.master_uri} is on another machine, which cannot reach a station "
                            "listening on loopback only: give --host ADDR, this machine's address on the lab network")
