@@ -187,23 +187,16 @@ def own_roscore_env(tmp_path: Path) -> dict[str, str]:
     return env
 
 
-def test_station_and_its_roscore_listen_on_loopback_only(tmp_path):
-    env = own_roscore_env(tmp_path)
-    with station(env, tmp_path) as st:
-        pids = {st.proc.pid, *descendants(st.proc.pid)}
-        listening = listening_addresses(pids)
-        st.stop()
-    port = int(env["ROS_MASTER_URI"].rsplit(":", 1)[1])
-    assert port in {p for _, p in listening}  # the roscore's master is among them
-    assert len(listening) >= 3, listening  # the master, the station's XML-RPC and TCPROS servers
-    assert {a for a, _ in listening} == {"127.0.0.1"}, listening
-
-
-def test_sigkill_of_the_station_leaves_no_process_and_no_log_behind(tmp_path):
+def test_loopback_only_and_sigkill_of_the_station_leaves_no_process_and_no_log_behind(tmp_path):
+    """Two bullets, one station (each start costs seconds): every listening socket of the station and its master
+    is on 127.0.0.1 (they were on 0.0.0.0); after a SIGKILL of the station alone nothing it started is left (the
+    roscore and its nodes were, with their logs)."""
     env = own_roscore_env(tmp_path)
     uri = env["ROS_MASTER_URI"]
+    port = int(uri.rsplit(":", 1)[1])
     with station(env, tmp_path) as st:
         below = descendants(st.proc.pid)
+        listening = listening_addresses({st.proc.pid, *below})
         assert master_answers(uri) and len(below) >= 2  # the guard and rosmaster
         assert list((tmp_path / "tmp").glob("ur3hanoi-roscore-*"))
         os.kill(st.proc.pid, signal.SIGKILL)  # the station alone: its children must follow by themselves
@@ -214,6 +207,9 @@ def test_sigkill_of_the_station_leaves_no_process_and_no_log_behind(tmp_path):
         left = [p for p in below if alive(p)]
         for p in left:
             os.kill(p, signal.SIGKILL)
+    assert port in {p for _, p in listening}  # the master is among them
+    assert len(listening) >= 3, listening  # the master, the station's XML-RPC and TCPROS servers
+    assert {a for a, _ in listening} == {"127.0.0.1"}, listening
     assert left == []
     assert not master_answers(uri)
     assert list((tmp_path / "tmp").iterdir()) == []
