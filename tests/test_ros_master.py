@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import os
+import signal
 import socket
 import subprocess
 import time
 
 import pytest
 
-from tests.ros_support import free_port, requires_ros, ros_env
+from tests.ros_support import alive, free_port, requires_ros, ros_env
 from ur3hanoi.ros.errors import RosError
 from ur3hanoi.ros.guard import LOG_DIR_PREFIX, remove_stale_log_dirs
 from ur3hanoi.ros.master import MasterUri, RosCore, listen_env, master_answers, master_pid, probe_master
@@ -88,3 +89,26 @@ def test_stale_log_dirs_of_dead_stations_are_removed(tmp_path):
         (d / "master.log").write_text("x")
     assert remove_stale_log_dirs(tmp_path) == [stale]
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([live.name, other.name])
+
+
+@pytest.mark.ros
+@requires_ros
+def test_the_guard_stops_the_master_and_removes_its_logs_on_sigterm_too(tmp_path, monkeypatch):
+    env = ros_env(free_port(), tmp_path)
+    monkeypatch.setenv("ROS_HOME", env["ROS_HOME"])
+    uri = env["ROS_MASTER_URI"]
+    core = RosCore(uri)
+    try:
+        core.start()
+        log_dir, guard = core.log_dir, core.guard_pid
+        assert log_dir is not None and guard is not None and (log_dir / "roscore.log").exists()
+        pid = master_pid(uri)
+        os.kill(guard, signal.SIGTERM)  # e.g. a system shutdown
+        deadline = time.monotonic() + 30.0
+        while alive(guard) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not alive(guard) and not master_answers(uri) and not log_dir.exists()
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
+    finally:
+        core.stop()

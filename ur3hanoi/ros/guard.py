@@ -9,7 +9,7 @@ in its own session with a pipe on its standard input that only the station holds
   roscore), its output appended to ``LOG_DIR/roscore.log``;
 - prints ``pid N`` (the roscore's process id) and, if roscore exits by itself, ``exit CODE`` on its stdout;
 - when its standard input reaches end of file -- the station closed it, or the kernel did because the station died,
-  even by SIGKILL -- stops roscore the way it wants to be stopped (SIGINT, twice), then SIGKILLs whatever of its
+  even by SIGKILL -- or on SIGTERM, stops roscore the way it wants to be stopped (SIGINT, twice), then SIGKILLs whatever of its
   process tree is left, removes ``LOG_DIR`` and exits.
 
 The station's temporary folders are named :data:`LOG_DIR_PREFIX` + the station's pid; :func:`remove_stale_log_dirs`
@@ -116,12 +116,21 @@ def stop_tree(proc: subprocess.Popen[bytes], sigint_timeout_s: float = 5.0) -> N
         proc.poll()
 
 
+class _TerminatedError(Exception):
+    """SIGTERM: stop roscore and clean up as on end of file."""
+
+
+def _stop_requested(_signum: int, _frame: object) -> None:
+    raise _TerminatedError
+
+
 def main(argv: list[str]) -> int:
     if len(argv) < 3 or argv[1] != "--":
         print("usage: python -m ur3hanoi.ros.guard LOG_DIR -- COMMAND...", file=sys.stderr)
         return 2
     log_dir, command = Path(argv[0]), argv[2:]
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # only the pipe stops the guard
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the pipe stops the guard (a Ctrl-C reaches the station first)
+    signal.signal(signal.SIGTERM, _stop_requested)  # so does a SIGTERM (system shutdown): cleanly
     _prctl(_PR_SET_CHILD_SUBREAPER, 1)
     parent = os.getppid()
 
@@ -135,16 +144,18 @@ def main(argv: list[str]) -> int:
                                     start_new_session=True, preexec_fn=child_setup)  # single-threaded here
         print(f"pid {proc.pid}", flush=True)
         reported = False
-        while True:
-            ready, _, _ = select.select([sys.stdin], [], [], 0.2)
-            if ready and not os.read(sys.stdin.fileno(), 4096):
-                break  # end of file: the station closed the pipe or died
-            if os.getppid() != parent:
-                break  # re-parented: the station is gone (belt and braces for the pipe)
-            if not reported and proc.poll() is not None:
-                reported = True
-                with contextlib.suppress(OSError):
-                    print(f"exit {proc.returncode}", flush=True)
+        with contextlib.suppress(_TerminatedError):
+            while True:
+                ready, _, _ = select.select([sys.stdin], [], [], 0.2)
+                if ready and not os.read(sys.stdin.fileno(), 4096):
+                    break  # end of file: the station closed the pipe or died
+                if os.getppid() != parent:
+                    break  # re-parented: the station is gone (belt and braces for the pipe)
+                if not reported and proc.poll() is not None:
+                    reported = True
+                    with contextlib.suppress(OSError):
+                        print(f"exit {proc.returncode}", flush=True)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
         stop_tree(proc)
     finally:
         shutil.rmtree(log_dir, ignore_errors=True)

@@ -188,6 +188,11 @@ class RosCore:
         return self._pid
 
     @property
+    def guard_pid(self) -> int | None:
+        """Process id of the guard (:mod:`ur3hanoi.ros.guard`) of the roscore this object started, or None."""
+        return None if self._guard is None else self._guard.pid
+
+    @property
     def log_dir(self) -> Path | None:
         """The temporary folder of the roscore's logs (removed when it stops), or None."""
         return self._log_dir
