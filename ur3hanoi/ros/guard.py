@@ -9,8 +9,8 @@ in its own session with a pipe on its standard input that only the station holds
   roscore), its output appended to ``LOG_DIR/roscore.log``;
 - prints ``pid N`` (the roscore's process id) and, if roscore exits by itself, ``exit CODE`` on its stdout;
 - when its standard input reaches end of file -- the station closed it, or the kernel did because the station died,
-  even by SIGKILL -- or on SIGTERM, stops roscore the way it wants to be stopped (SIGINT, twice), then SIGKILLs whatever of its
-  process tree is left, removes ``LOG_DIR`` and exits.
+  even by SIGKILL -- or on SIGTERM, stops roscore the way it wants to be stopped (SIGINT, twice), then SIGKILLs
+  whatever of its process tree is left, removes ``LOG_DIR`` and exits.
 
 The station's temporary folders are named :data:`LOG_DIR_PREFIX` + the station's pid; :func:`remove_stale_log_dirs`
 removes those of stations that no longer run (a guard killed with SIGKILL cannot clean up).
