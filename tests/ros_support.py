@@ -63,7 +63,7 @@ class Station:
         self.stderr: list[str] = []
         self._ready = threading.Event()
         self._threads = [threading.Thread(target=self._pump, args=(proc.stdout, self.stdout, True), daemon=True),
-                         threading.Thread(target=self._pump, args=(proc.stderr, self.stderr, False), daemon=True)]
+                         threading.Thread(target=self._pump, args=(proc.stderr, self.stderr, True), daemon=True)]
         for t in self._threads:
             t.start()
 
@@ -173,3 +173,61 @@ def run(cmd: list[str], env: dict[str, str], timeout: float, stdin: str | None =
 def final_slots(report: dict[str, Any]) -> dict[int, tuple[int | None, int | None]]:
     """block -> (tower, height), 1-based, from a station report."""
     return {b["block"]: (b["tower"], b["height"]) for b in report["final"]["blocks"]}
+
+
+def descendants(pid: int) -> set[int]:
+    """Every process below ``pid`` (by parent id, read from /proc)."""
+    parents: dict[int, int] = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                stat = (entry / "stat").read_text()
+            except OSError:
+                continue
+            parents[int(entry.name)] = int(stat.rsplit(")", 1)[1].split()[1])
+    found: set[int] = set()
+    todo = [pid]
+    while todo:
+        p = todo.pop()
+        kids = [c for c, pp in parents.items() if pp == p and c not in found]
+        found.update(kids)
+        todo += kids
+    return found
+
+
+def alive(pid: int) -> bool:
+    """True while ``pid`` exists and is not a zombie."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def listening_addresses(pids: set[int]) -> list[tuple[str, int]]:
+    """(address, port) of every listening TCP socket (IPv4 and IPv6) held by ``pids``, from /proc/net/tcp*."""
+    inodes: set[str] = set()
+    for pid in pids:
+        try:
+            for fd in Path(f"/proc/{pid}/fd").iterdir():
+                try:
+                    target = os.readlink(fd)
+                except OSError:
+                    continue
+                if target.startswith("socket:["):
+                    inodes.add(target[8:-1])
+        except OSError:
+            continue
+    out = []
+    for table, width in (("tcp", 8), ("tcp6", 32)):
+        for line in Path(f"/proc/net/{table}").read_text().splitlines()[1:]:
+            fields = line.split()
+            if fields[3] != "0A" or fields[9] not in inodes:  # 0A: LISTEN
+                continue
+            hex_addr, hex_port = fields[1].split(":")
+            raw = bytes.fromhex(hex_addr)
+            if width == 8:
+                addr = socket.inet_ntop(socket.AF_INET, raw[::-1])
+            else:  # four little-endian 32-bit words
+                addr = socket.inet_ntop(socket.AF_INET6, b"".join(raw[i:i + 4][::-1] for i in range(0, 16, 4)))
+            out.append((addr, int(hex_port, 16)))
+    return out

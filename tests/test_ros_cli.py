@@ -24,6 +24,10 @@ def error_line(capsys) -> str:
     (["ros-station", "--start", "4"], "start tower 4 is invalid: expected 1..3"),
     (["ros-station", "--remove-block", "5"], "removed block height 5 is invalid: expected 1..3"),
     (["ros-station", "--master", "localhost:11311"], "ROS master URI 'localhost:11311' is invalid"),
+    (["ros-station", "--master", "http://robot-pc.example:11311"],
+     "the ROS master http://robot-pc.example:11311 is on another machine, which cannot reach a station listening on "
+     "loopback only: give --host ADDR"),
+    (["ros-station", "--host", "lab-pc"], "host 'lab-pc' is invalid: expected this machine's IP address"),
     (["ros-env", "--master", "http://localhost"], "ROS master URI 'http://localhost' is invalid"),
 ])
 def test_bad_arguments_exit_2_with_one_line(argv, message, capsys, monkeypatch):

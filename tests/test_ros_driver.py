@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import numpy as np
@@ -27,7 +28,7 @@ def test_refused_commands_do_not_move_the_arm(driver, lab_sim):
     for _ in range(100):
         driver.cycle()
     assert np.max(np.abs(driver.world.q - home)) < 1e-6
-    assert not driver.world.suction_on and driver.executed == [] and driver.ready
+    assert not driver.world.suction_on and not driver.executed and driver.ready
     assert [r.reason.split(" ")[0] for r in driver.rejected] == ["destination", "destination[0]", "destination[0]",
                                                                  "v"]
 
@@ -63,3 +64,47 @@ def test_lead_joint_speed_is_capped(driver, lab_sim):
     move = driver.executed[0]
     assert move.lead_velocity == pytest.approx(math.pi)  # 180 deg/s, the UR3's base
     assert move.lead_acceleration == pytest.approx(4.0)
+
+
+@pytest.mark.parametrize(("v", "a"), [(1e-9, 1e-9), (4.0, 1e-9), (1e-9, 4.0), (5e-324, 5e-324), (0.001, 0.001)])
+def test_a_move_longer_than_the_cap_is_refused_and_the_next_command_runs(driver, lab_sim, v, a):
+    """v = a = 1e-9 was accepted as a 5e8 s move and the station never moved again."""
+    q1 = lab_sim.q_home_array.copy()
+    q1[0] += 0.5
+    with pytest.raises(CommandError, match=r"the move would take .* s at v = .*: expected at most 60 s"):
+        driver.submit(list(q1), v, a, True)
+    assert not driver.queue and driver.n_rejected == 1
+    driver.submit(list(q1), 4.0, 4.0, False)
+    for _ in range(round(1.0 / driver.world.config.period_s)):
+        driver.cycle()
+    assert driver.n_executed == 1 and np.max(np.abs(driver.world.q - q1)) < 5e-4 and driver.ready
+
+
+def test_the_cap_allows_the_slowest_course_speed_and_huge_finite_values(driver, lab_sim):
+    q1 = lab_sim.q_home_array.copy()
+    q1[0] -= 5.0  # the base, 5 rad at v = a = 0.1: 51 s
+    driver.submit(list(q1), 0.1, 0.1, False)
+    driver.submit(list(lab_sim.q_home_array), 1e300, 1e300, False)  # capped at the UR3's limits
+    assert len(driver.queue) == 2
+    driver.cycle()
+    assert driver.executed[0].duration_s == pytest.approx(5.0 / 0.1 + 1.0)
+    assert driver.summary()["max_move_s"] == 60.0
+
+
+def test_records_are_bounded_and_totals_count_every_command(lab_sim):
+    """A flood of commands: the kept records and the summary's size do not grow with the number of commands."""
+    driver = StationDriver(StationWorld(lab_sim, 0, 3), max_queue=5, records_kept=10)
+    home = list(lab_sim.q_home_array)
+    near = [home[0] + 0.01, *home[1:]]
+    sent = 0
+    for _ in range(400):
+        for _ in range(3):
+            with contextlib.suppress(CommandError):
+                driver.submit(near if sent % 2 else home, 4.0, 4.0, False)
+            sent += 1
+        driver.cycle()
+    s = driver.summary()
+    assert s["executed"] + s["rejected"] + s["queued"] == sent
+    assert s["executed"] > 10 and s["rejected"] > 10
+    assert len(driver.executed) == 10 and len(driver.rejected) == 10
+    assert s["max_error_after_settling_rad"] is not None and s["superseded_before_settling"] >= 0

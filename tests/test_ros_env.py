@@ -83,3 +83,29 @@ def test_sitecustomize_runs_the_next_one_on_the_path(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True,
                          env=dict(os.environ, PYTHONPATH=f"{folder}:{other}"))
     assert out.stdout.strip() == "True"
+
+
+@requires_ros
+@pytest.mark.parametrize("python", [sys.executable, "/usr/bin/python3"])
+def test_ros_env_applied_twice_is_harmless(tmp_path, python):
+    """Twice the same folder, then a second folder, then a foreign sitecustomize: every Python still starts (it
+    raised RecursionError), the messages import and the foreign sitecustomize runs exactly once."""
+    if not Path(python).exists():
+        pytest.skip(f"no {python}")
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "sitecustomize.py").write_text("import builtins\n"
+                                            "builtins.ur3hanoi_runs = getattr(builtins, 'ur3hanoi_runs', 0) + 1\n")
+    evals = " && ".join(f'eval "$({shlex.join(ur3hanoi_cmd("ros-env", "--dir", str(tmp_path / d)))})"'
+                        for d in ("a", "a", "b"))
+    code = ("import builtins, rospy; from ur3_driver.msg import command; "
+            "print(command._md5sum, getattr(builtins, 'ur3hanoi_runs', 0))")
+    env = {k: v for k, v in os.environ.items() if k != "ROS_MASTER_URI"}
+    env["PYTHONPATH"] = str(other)
+    shell = f"{evals} && echo \"$PYTHONPATH\" && exec {shlex.quote(python)} -c {shlex.quote(code)}"
+    out = subprocess.run(["bash", "-c", shell], capture_output=True, text=True, timeout=120, env=env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "Error in sitecustomize" not in out.stderr and "RecursionError" not in out.stderr, out.stderr[-2000:]
+    lines = out.stdout.splitlines()
+    assert lines[0].split(":") == [str(tmp_path / "b"), str(tmp_path / "a"), str(tmp_path / "a"), str(other)]
+    assert lines[1].split() == [MD5[0], "1"]

@@ -53,8 +53,11 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
                     "controller's movej (v and a capped at the UR3 limits: 180 deg/s joints 1-3, 360 deg/s wrists, "
                     "4/8 rad/s^2), switches suction with io_0, publishes ur3/position and ur3/gripper_input at "
                     "--rate in real time. Topics ur3hanoi/spawn (std_msgs/Int32 tower) and ur3hanoi/remove_block "
-                    "(block, 1 = bottom) respawn and remove blocks. Starts a roscore when none answers. On "
-                    "SIGINT/SIGTERM (and SIGUSR1, without stopping) writes a JSON report to --report or stdout.")
+                    "(block, 1 = bottom) respawn and remove blocks. Starts a roscore when none answers (stopped "
+                    "with the station, even when it is killed). Listens on 127.0.0.1 only unless --host. Refuses "
+                    "moves longer than 60 s and more than 100 waiting commands; logs at most one line per topic "
+                    "and second. On SIGINT/SIGTERM (and SIGUSR1, without stopping) writes a JSON report to "
+                    "--report or stdout; everything else goes to stderr.")
     p.add_argument("--calibration", default=None, metavar="CAL",
                    help=f"station calibration YAML or shipped name (default {DEFAULT_CALIBRATION})")
     p.add_argument("--start", type=option(TOWER), default=1, metavar="T",
@@ -71,6 +74,10 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--report", metavar="FILE", help="write the JSON report to FILE (default: stdout)")
     p.add_argument("--duration", type=option(DURATION), metavar="S", help="stop by itself after S seconds")
     p.add_argument("--master", metavar="URI", help=_master_help())
+    p.add_argument("--host", metavar="ADDR", default="127.0.0.1",
+                   help="address the station and the roscore it starts listen on and advertise (ROS_IP); default "
+                        "127.0.0.1: this machine only. Give this machine's lab-network address to open them to "
+                        "other machines (a master on another machine needs it)")
     out = p.add_mutually_exclusive_group()
     out.add_argument("--video", metavar="FILE.mp4", help="render an MP4 offscreen (headless: MUJOCO_GL=egl)")
     out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR")
@@ -88,15 +95,28 @@ def _run_station(args: argparse.Namespace) -> int:
         drop_on_grasp=None if args.drop_on_grasp is None else args.drop_on_grasp - 1, seed=args.seed,
         rate_hz=args.rate, report=Path(args.report) if args.report else None,
         frames=Path(args.frames) if args.frames else None, video=Path(args.video) if args.video else None,
-        duration_s=args.duration, master_uri=args.master)
-    report = RosStation(options).run()
+        duration_s=args.duration, master_uri=args.master, host=args.host)
+    node = RosStation(options)
+    # Standard output carries only the JSON report: whatever else writes to file descriptor 1 (rospy's info
+    # handler, C libraries) goes to stderr while the node runs.
+    sys.stdout.flush()
+    report_fd = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        with os.fdopen(os.dup(report_fd), "w") as report_out:
+            node.report_out = lambda text: print(text, file=report_out, flush=True)
+            report = node.run()
+    finally:
+        sys.stdout.flush()
+        os.dup2(report_fd, 1)
+        os.close(report_fd)
     if args.report:
         c, ctl = report["commands"], report["control"]
         blocks = ", ".join(f"{b['block']} " + ("off-grid" if b["tower"] is None else
                                               f"tower {b['tower']} height {b['height']}")
                            for b in report["final"]["blocks"])
         print(f"ros-station stopped: {c['executed']} commands executed, {c['rejected']} refused; blocks {blocks}; "
-              f"worst loop lag {1e3 * ctl['worst_lag_s']:.2f} ms; report {args.report}", flush=True)
+              f"worst loop lag {1e3 * ctl['worst_lag_s']:.2f} ms; report {args.report}", file=sys.stderr, flush=True)
     return 0
 
 

@@ -48,9 +48,10 @@ def parse_command(destination: Sequence[float], v: object, a: object, io_0: obje
     Raises:
         CommandError: naming the bad field and value and what is valid (6 angles within ``limits``, v > 0, a > 0).
     """
+    n = len(destination)  # before copying: a flood of huge arrays must cost nothing but their refusal
+    if n != N_JOINTS:
+        raise CommandError(f"destination has {n} values: expected {N_JOINTS} joint angles [rad]")
     values = list(destination)
-    if len(values) != N_JOINTS:
-        raise CommandError(f"destination has {len(values)} values: expected {N_JOINTS} joint angles [rad]")
     q = []
     for i, raw in enumerate(values):
         try:

@@ -6,6 +6,17 @@ queue); the lab's ``move_arm`` re-publishes its command every 5 s while waiting,
 move, never a jump. Every executed command is recorded with its duration, the time the arm needed to come within
 the settle tolerance after the profile ended, and the error it rested at, so the report shows whether the lab's
 0.0005 rad wait would return.
+
+What cannot wedge the station:
+
+- a command whose ``movej`` would take longer than :data:`MAX_MOVE_S` (planned from where the previous command
+  ends) is refused: ``v = a = 1e-9`` would otherwise be a 5e8 s move and the station would never move again. 60 s
+  covers every lab move at the slowest speeds course drivers accept (``v = a = 0.1``: a lead joint up to 5.9 rad);
+- at most ``max_queue`` (100) accepted commands wait; further ones are refused until the queue drains (a runaway
+  publisher must not queue minutes of motion);
+- the records are bounded: totals and worst figures over every command, and only the last
+  :data:`RECORDS_KEPT` executed and refused commands in full, so memory and the report stay the same size
+  however many commands arrive.
 """
 
 from __future__ import annotations
@@ -17,7 +28,14 @@ from typing import Any
 
 from ur3hanoi.ros.command import MoveCommand, parse_command
 from ur3hanoi.ros.errors import CommandError
+from ur3hanoi.ros.movej import plan_movej
 from ur3hanoi.ros.world import StationWorld
+
+MAX_MOVE_S = 60.0
+"""Longest ``movej`` [s] the station accepts (see the module docstring)."""
+
+RECORDS_KEPT = 100
+"""How many executed and how many refused commands the driver keeps in full (the report's lists)."""
 
 
 @dataclass
@@ -63,17 +81,34 @@ class StationDriver:
         world: the simulated station.
         max_queue: commands waiting beyond this many are refused (a runaway publisher must not queue minutes).
         min_rest_s: the summary's rest error counts only rests at least this long [s].
+        max_move_s: commands whose move would take longer [s] are refused.
+        records_kept: the last this many executed and refused commands are kept in full.
     """
 
-    def __init__(self, world: StationWorld, max_queue: int = 100, min_rest_s: float = 0.2) -> None:
+    def __init__(self, world: StationWorld, max_queue: int = 100, min_rest_s: float = 0.2,
+                 max_move_s: float = MAX_MOVE_S, records_kept: int = RECORDS_KEPT) -> None:
         self.world = world
         self.max_queue = max_queue
         self.min_rest_s = min_rest_s
+        self.max_move_s = max_move_s
         self.queue: deque[MoveCommand] = deque()
-        self.executed: list[ExecutedMove] = []
-        self.rejected: list[Rejection] = []
+        self.executed: deque[ExecutedMove] = deque(maxlen=records_kept)
+        self.rejected: deque[Rejection] = deque(maxlen=records_kept)
+        self.n_executed = 0
+        self.n_rejected = 0
         self._current: ExecutedMove | None = None
         self._profile_end: float | None = None
+        # Aggregates over the closed records (every executed command but the current one).
+        self._superseded = 0
+        self._max_settle: float | None = None
+        self._max_rest: float | None = None
+        self._max_drift: float | None = None
+
+    def refuse(self, reason: str) -> CommandError:
+        """Record a refused command; returns the error to raise."""
+        self.n_rejected += 1
+        self.rejected.append(Rejection(self.world.time, reason))
+        return CommandError(reason)
 
     def submit(self, destination: Sequence[float], v: object, a: object, io_0: object) -> MoveCommand:
         """Queue a ``ur3/command``.
@@ -86,9 +121,14 @@ class StationDriver:
             if len(self.queue) >= self.max_queue:
                 raise CommandError(f"{len(self.queue)} commands are already waiting: expected at most "
                                    f"{self.max_queue} queued commands")
+            start = self.queue[-1].destination if self.queue else self.world.target
+            lim = self.world.station.limits
+            duration = plan_movej(start, command.destination, command.v, command.a, lim.v_max, lim.a_max).duration
+            if not duration <= self.max_move_s:
+                raise CommandError(f"the move would take {duration:.3g} s at v = {command.v!r} rad/s, a = "
+                                   f"{command.a!r} rad/s^2: expected at most {self.max_move_s:g} s (raise v or a)")
         except CommandError as exc:
-            self.rejected.append(Rejection(self.world.time, str(exc)))
-            raise
+            raise self.refuse(str(exc)) from None
         self.queue.append(command)
         return command
 
@@ -101,16 +141,30 @@ class StationDriver:
         if self._current is not None and self._current.settle_s is not None:
             self._current.rest_error_rad = self.world.error_to_target()
 
+    def _fold(self, m: ExecutedMove) -> None:
+        """Add a closed record to the aggregates."""
+        if m.settle_s is None:
+            self._superseded += 1
+        else:
+            self._max_settle = _max(self._max_settle, m.settle_s)
+        if m.rest_error_rad is not None and m.rest_s >= self.min_rest_s:
+            self._max_rest = _max(self._max_rest, m.rest_error_rad)
+        if m.rest_max_error_rad is not None:
+            self._max_drift = _max(self._max_drift, m.rest_max_error_rad)
+
     def cycle(self) -> None:
         """One control period: start the next queued command when the arm is free, step the world, measure."""
         w = self.world
         if not w.moving and self.queue:
             self._close_rest()
+            if self._current is not None:
+                self._fold(self._current)
             command = self.queue.popleft()
             motion = w.begin(command)
             v, acc = motion.peak_velocity, motion.peak_acceleration
             self._current = ExecutedMove(command, w.time, motion.duration, float(v.max()), float(acc.max()))
             self.executed.append(self._current)
+            self.n_executed += 1
             self._profile_end = None if w.moving else w.time
         w.step()
         cur = self._current
@@ -127,21 +181,31 @@ class StationDriver:
                 cur.rest_s = w.time - self._profile_end - cur.settle_s
 
     def summary(self) -> dict[str, Any]:
-        """Counts and the worst settle figures of the executed commands."""
+        """Counts and the worst settle figures over every executed command (not only the kept records)."""
         self._close_rest()
-        settles = [m.settle_s for m in self.executed if m.settle_s is not None]
-        # At rest: the arm stayed at least min_rest_s (clients that move on at once never let it rest).
-        rests = [m.rest_error_rad for m in self.executed
-                 if m.rest_error_rad is not None and m.rest_s >= self.min_rest_s]
-        drifts = [m.rest_max_error_rad for m in self.executed if m.rest_max_error_rad is not None]
+        superseded, settle, rest, drift = self._superseded, self._max_settle, self._max_rest, self._max_drift
+        m = self._current
+        if m is not None:  # the current command, not folded yet
+            superseded += m.settle_s is None
+            settle = _max(settle, m.settle_s)
+            if m.rest_error_rad is not None and m.rest_s >= self.min_rest_s:
+                rest = _max(rest, m.rest_error_rad)
+            drift = _max(drift, m.rest_max_error_rad)
         return {
-            "executed": len(self.executed),
-            "rejected": len(self.rejected),
+            "executed": self.n_executed,
+            "rejected": self.n_rejected,
             "queued": len(self.queue),
             # The next command started before this one came within tolerance (the client moved on early).
-            "superseded_before_settling": sum(1 for m in self.executed if m.settle_s is None),
-            "max_settle_s": round(max(settles), 4) if settles else None,
-            "max_rest_error_rad": max(rests) if rests else None,
-            "max_error_after_settling_rad": max(drifts) if drifts else None,
+            "superseded_before_settling": superseded,
+            "max_settle_s": round(settle, 4) if settle is not None else None,
+            "max_rest_error_rad": rest,
+            "max_error_after_settling_rad": drift,
             "settle_tolerance_rad": self.world.config.settle_tolerance_rad,
+            "max_move_s": self.max_move_s,
+            "max_queue": self.max_queue,
+            "records_kept": self.executed.maxlen,
         }
+
+
+def _max(a: float | None, b: float | None) -> float | None:
+    return b if a is None else a if b is None else max(a, b)

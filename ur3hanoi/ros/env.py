@@ -63,15 +63,15 @@ def import_std_msgs() -> ModuleType:
     return importlib.import_module("std_msgs.msg")
 
 
-def roscore_executable() -> str:
-    """Path of ``roscore``.
+def roscore_executable(name: str = "roscore") -> str:
+    """Path of ``roscore`` (or another program of package ``ros-core``, e.g. ``rosmaster``).
 
     Raises:
         RosUnavailableError: not on PATH (package ``ros-core`` missing).
     """
-    path = shutil.which("roscore")
+    path = shutil.which(name)
     if path is None:
-        raise RosUnavailableError(f"roscore is not on PATH: {_INSTALL_HINT}")
+        raise RosUnavailableError(f"{name} is not on PATH: {_INSTALL_HINT}")
     return path
 
 
@@ -81,29 +81,41 @@ def default_cache_dir() -> Path:
     return Path(base) / "ur3hanoi" / "ros"
 
 
-SITECUSTOMIZE = f'''"""Written by `ur3hanoi ros-env`: lets any Python 3 import Debian's ROS 1 packages (rospy,
+SITECUSTOMIZE_MARK = "Written by `ur3hanoi ros-env`"
+"""How a ``sitecustomize.py`` written by ``ros-env`` (any version, any folder) is recognised: never chained to."""
+
+SITECUSTOMIZE = f'''"""{SITECUSTOMIZE_MARK}: lets any Python 3 import Debian's ROS 1 packages (rospy,
 genpy) and the course's ur3_driver messages beside this file. Debian's folder is APPENDED to sys.path, so a virtual
 environment's own packages (numpy, PyYAML) keep precedence. Then runs the next sitecustomize on the path (e.g.
-Debian's), which this file would otherwise hide."""
+Debian's), which this file would otherwise hide: once per process, and never another one written by ros-env
+(`ros-env` applied twice, or with two folders, must not chain these files into each other forever)."""
 import importlib.util as _util
 import os as _os
 import sys as _sys
 
 _ROS = {str(ROS_PYTHON_DIR)!r}
+_MARK = {SITECUSTOMIZE_MARK.encode()!r}
 if _os.path.isdir(_ROS) and _ROS not in _sys.path:
     _sys.path.append(_ROS)
 
 
 def _chain():
-    here = _os.path.dirname(_os.path.abspath(__file__))
+    if getattr(_sys, "_ur3hanoi_ros_env_chained", False):
+        return
+    _sys._ur3hanoi_ros_env_chained = True
     for entry in list(_sys.path):
-        folder = _os.path.abspath(entry or ".")
-        path = _os.path.join(folder, "sitecustomize.py")
-        if folder != here and _os.path.isfile(path):
-            spec = _util.spec_from_file_location("_ur3hanoi_next_sitecustomize", path)
-            if spec is not None and spec.loader is not None:
-                spec.loader.exec_module(_util.module_from_spec(spec))
-            return
+        path = _os.path.join(_os.path.abspath(entry or "."), "sitecustomize.py")
+        try:
+            with open(path, "rb") as f:
+                head = f.read(512)
+        except OSError:
+            continue
+        if _MARK in head:
+            continue
+        spec = _util.spec_from_file_location("_ur3hanoi_next_sitecustomize", path)
+        if spec is not None and spec.loader is not None:
+            spec.loader.exec_module(_util.module_from_spec(spec))
+        return
 
 
 _chain()

@@ -1,10 +1,19 @@
 """The ROS master: parse ``ROS_MASTER_URI``, ask whether a master answers, start and stop a ``roscore``.
 
 :class:`RosCore` is a context manager: when no master answers at the URI (and the URI names this machine) it
-starts ``roscore -p PORT`` in its own session, waits until its ``rosout`` node is registered too, and stops it on
-exit (SIGINT, the way roscore wants to be stopped; SIGKILL of it and its children only if it does not exit within
-the timeout). A master that already answers is
-used and left running.
+starts ``roscore -p PORT`` under a guard process (:mod:`ur3hanoi.ros.guard`) and waits until its ``rosout`` node is
+registered too; on exit the guard stops it (SIGINT, the way roscore wants to be stopped; SIGKILL of what is left).
+The guard also does so when the station dies, even by SIGKILL, and the roscore's logs live in a temporary folder
+the guard removes. A master that already answers is used and left running.
+
+Listening: the master started here binds and advertises ``host`` (``ROS_IP``; default ``127.0.0.1``, loopback
+only; any other address binds all interfaces, as rosgraph does). On loopback it is ``rosmaster --core`` alone, the
+master roscore would run, without roscore's ``rosout`` node: rosout's C++ XML-RPC server (xmlrpcpp) listens on
+every interface whatever ``ROS_IP`` says (measured), and nothing the lab uses needs it (nodes log to their stderr
+and log files; ``/rosout`` simply has no subscriber). With another ``host`` the full ``roscore`` runs.
+
+A port where something accepts connections but does not answer like a master within :data:`PROBE_TIMEOUT_S` is
+an error at once (no roscore is started there).
 """
 
 from __future__ import annotations
@@ -12,10 +21,12 @@ from __future__ import annotations
 import contextlib
 import http.client
 import os
+import select
+import shutil
 import signal
 import socket
 import subprocess
-import tempfile
+import sys
 import time
 import xmlrpc.client
 from dataclasses import dataclass
@@ -28,6 +39,28 @@ from ur3hanoi.ros.env import roscore_executable
 from ur3hanoi.ros.errors import RosError
 
 DEFAULT_MASTER_URI = "http://localhost:11311"
+
+LOOPBACK = "127.0.0.1"
+"""Default address the station and its roscore listen on and advertise (``ROS_IP``): this machine only."""
+
+PROBE_TIMEOUT_S = 1.0
+"""How long [s] a master may take to answer ``getPid`` before the URI counts as not answering."""
+
+
+def is_loopback(host: str) -> bool:
+    """True for ``localhost``, 127.0.0.0/8 and ``::1``."""
+    return host in ("localhost", "::1") or host.startswith("127.")
+
+
+def listen_env(env: dict[str, str], host: str) -> dict[str, str]:
+    """``env`` with ``ROS_IP=host``: Python nodes (rosgraph prefers ROS_IP) bind a loopback ``host`` only, any
+    other address on all interfaces. For a loopback ``host`` also ``ROS_HOSTNAME=localhost``, which the C++ nodes
+    (roscpp: rosout) read first and take as "loopback only"; otherwise no ``ROS_HOSTNAME``."""
+    out = {k: v for k, v in env.items() if k != "ROS_HOSTNAME"}
+    out["ROS_IP"] = host
+    if is_loopback(host):
+        out["ROS_HOSTNAME"] = "localhost"
+    return out
 
 
 @dataclass(frozen=True)
@@ -54,7 +87,7 @@ class MasterUri:
     @property
     def is_local(self) -> bool:
         """True when the host is this machine (loopback, or its own host name)."""
-        if self.host in ("localhost", "::1") or self.host.startswith("127."):
+        if is_loopback(self.host):
             return True
         return self.host in (socket.gethostname(), socket.getfqdn())
 
@@ -77,15 +110,36 @@ class _TimeoutTransport(xmlrpc.client.Transport):
         return conn
 
 
-def master_pid(uri: str, timeout: float = 1.0) -> int | None:
-    """The process id of the ROS master answering at ``uri``, or None when none answers within ``timeout`` [s]."""
+def probe_master(uri: str, timeout: float = PROBE_TIMEOUT_S) -> int | None:
+    """The process id of the ROS master answering at ``uri``; None when nothing listens there.
+
+    Raises:
+        RosError: something accepts connections at ``uri`` but does not answer like a ROS master within
+            ``timeout`` [s] (each of connect and reply).
+    """
     proxy = xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(timeout))
     try:
         reply: Any = proxy.getPid("/ur3hanoi_probe")
         code, _msg, pid = reply
-    except (OSError, xmlrpc.client.Error, ValueError, TypeError):
+        if code == 1:
+            return int(pid)
+        why = f"it answered {reply!r}"
+    except ConnectionRefusedError:
         return None
-    return int(pid) if code == 1 else None
+    except TimeoutError:
+        why = f"no answer within {timeout:g} s"
+    except (OSError, xmlrpc.client.Error, ValueError, TypeError) as exc:
+        why = f"{type(exc).__name__}: {exc}"
+    raise RosError(f"something at {uri} accepts connections but is not a ROS master ({why}): stop it, or use "
+                   "another port (--master http://localhost:PORT)")
+
+
+def master_pid(uri: str, timeout: float = PROBE_TIMEOUT_S) -> int | None:
+    """The process id of the ROS master answering at ``uri``, or None when none answers within ``timeout`` [s]."""
+    try:
+        return probe_master(uri, timeout)
+    except RosError:
+        return None
 
 
 def node_registered(uri: str, node: str, timeout: float = 1.0) -> bool:
@@ -103,58 +157,81 @@ def master_answers(uri: str, timeout: float = 1.0) -> bool:
     return master_pid(uri, timeout) is not None
 
 
-def _children(pid: int) -> list[int]:
-    try:
-        text = Path(f"/proc/{pid}/task/{pid}/children").read_text()
-    except OSError:
-        return []
-    return [int(p) for p in text.split()]
-
-
 class RosCore:
     """Use the master at ``uri``, starting ``roscore -p PORT`` when none answers (see the module docstring).
 
-    Attributes:
+    Args:
         uri: the master URI.
+        host: address the roscore started here listens on and advertises (default loopback only).
+
+    Attributes:
         started: True when this object started the roscore (and will stop it).
     """
 
-    def __init__(self, uri: str, start_timeout: float = 30.0, stop_timeout: float = 15.0) -> None:
+    def __init__(self, uri: str, start_timeout: float = 30.0, stop_timeout: float = 15.0,
+                 host: str = LOOPBACK) -> None:
         self.master = MasterUri.parse(uri)
         self.uri = uri
+        self.host = host
         self.start_timeout = start_timeout
         self.stop_timeout = stop_timeout
         self.started = False
-        self._proc: subprocess.Popen[bytes] | None = None
-        self._log: Path | None = None
+        self._guard: subprocess.Popen[bytes] | None = None
+        self._pid: int | None = None
+        self._exit: int | None = None
+        self._log_dir: Path | None = None
+        self._buf = b""
 
     @property
     def pid(self) -> int | None:
         """Process id of the roscore this object started (None when it uses a running master)."""
-        return None if self._proc is None else self._proc.pid
+        return self._pid
+
+    @property
+    def guard_pid(self) -> int | None:
+        """Process id of the guard (:mod:`ur3hanoi.ros.guard`) of the roscore this object started, or None."""
+        return None if self._guard is None else self._guard.pid
+
+    @property
+    def log_dir(self) -> Path | None:
+        """The temporary folder of the roscore's logs (removed when it stops), or None."""
+        return self._log_dir
+
+    @property
+    def with_rosout(self) -> bool:
+        """True when the full ``roscore`` (with ``rosout``) is started: ``host`` is not loopback."""
+        return not is_loopback(self.host)
 
     def start(self) -> RosCore:
-        """Start ``roscore`` unless a master answers. Raises RosError when it does not answer in time."""
-        if master_answers(self.uri):
+        """Start ``roscore`` (``rosmaster`` on loopback) unless a master answers. Raises RosError when it does
+        not answer in time, or something else holds the port."""
+        from ur3hanoi.ros.guard import make_log_dir, remove_stale_log_dirs
+
+        if probe_master(self.uri) is not None:
             return self
         if not self.master.is_local:
             raise RosError(f"no ROS master answers at {self.uri} and its host {self.master.host!r} is not this "
                            "machine: start roscore there, or set ROS_MASTER_URI to http://localhost:PORT")
-        exe = roscore_executable()
-        fd, log = tempfile.mkstemp(prefix=f"ur3hanoi-roscore-{self.master.port}-", suffix=".log")
-        self._log = Path(log)
-        env = dict(os.environ, ROS_MASTER_URI=self.uri)
-        with os.fdopen(fd, "wb") as out:
-            # Own session: a Ctrl-C in the terminal reaches the station first, which then stops roscore in order.
-            self._proc = subprocess.Popen([exe, "-p", str(self.master.port)], stdin=subprocess.DEVNULL, stdout=out,
-                                          stderr=subprocess.STDOUT, env=env, start_new_session=True)
+        exe = roscore_executable("roscore" if self.with_rosout else "rosmaster")
+        args = [exe, "-p", str(self.master.port)] if self.with_rosout else [exe, "--core", "-p", str(self.master.port)]
+        remove_stale_log_dirs()
+        self._log_dir = make_log_dir()
+        env = listen_env(dict(os.environ, ROS_MASTER_URI=self.uri), self.host)
+        # The guard (own session: a Ctrl-C in the terminal reaches the station first, which then stops roscore in
+        # order) reads the pipe on its stdin: end of file, when this process closes it or dies, stops roscore.
+        self._guard = subprocess.Popen(
+            [sys.executable, "-m", "ur3hanoi.ros.guard", str(self._log_dir), "--", *args],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env,
+            start_new_session=True, bufsize=0)
         self.started = True
         deadline = time.monotonic() + self.start_timeout
         while time.monotonic() < deadline:
+            self._read_guard()
             # Up when rosout has registered too: roscore ignores a SIGINT that arrives while it still launches it.
-            if node_registered(self.uri, "/rosout", timeout=0.5):
+            if self._pid is not None and (node_registered(self.uri, "/rosout", timeout=0.5) if self.with_rosout
+                                          else master_answers(self.uri, timeout=0.5)):
                 return self
-            if self._proc.poll() is not None:
+            if self._exit is not None or self._guard.poll() is not None:
                 break
             time.sleep(0.1)
         tail = self._log_tail()
@@ -162,35 +239,54 @@ class RosCore:
         raise RosError(f"roscore -p {self.master.port} did not answer at {self.uri} within {self.start_timeout:g} s "
                        f"(port in use?): {tail}")
 
+    def _read_guard(self) -> None:
+        """Take the guard's ``pid N`` / ``exit CODE`` lines that are there (never blocks)."""
+        guard = self._guard
+        if guard is None or guard.stdout is None:
+            return
+        fd = guard.stdout.fileno()
+        while select.select([fd], [], [], 0)[0]:
+            chunk = os.read(fd, 4096)
+            if not chunk:
+                break
+            self._buf += chunk
+        *lines, self._buf = self._buf.split(b"\n")
+        for raw in lines:
+            words = raw.decode(errors="replace").split()
+            if len(words) == 2 and words[0] == "pid":
+                self._pid = int(words[1])
+            elif len(words) == 2 and words[0] == "exit":
+                self._exit = int(words[1])
+
     def _log_tail(self) -> str:
-        if self._log is None or not self._log.exists():
+        log = None if self._log_dir is None else self._log_dir / "roscore.log"
+        if log is None or not log.exists():
             return "no output"
-        lines = [ln.strip() for ln in self._log.read_text(errors="replace").splitlines() if ln.strip()]
+        lines = [ln.strip() for ln in log.read_text(errors="replace").splitlines() if ln.strip()]
         return " | ".join(lines[-3:]) if lines else "no output"
 
     def stop(self) -> None:
-        """Stop the roscore this object started (SIGINT, then SIGKILL of it and its children); no-op otherwise."""
-        proc, self._proc = self._proc, None
-        if proc is not None and proc.poll() is None:
-            children = _children(proc.pid)
+        """Stop the roscore this object started (close the guard's pipe and wait); no-op otherwise."""
+        guard, self._guard = self._guard, None
+        if guard is not None:
+            with contextlib.suppress(OSError):
+                if guard.stdin is not None:
+                    guard.stdin.close()
             try:
-                # A second SIGINT covers one that roscore missed while it was busy launching its nodes.
-                for wait_s in (min(5.0, self.stop_timeout), self.stop_timeout):
-                    proc.send_signal(signal.SIGINT)
-                    with contextlib.suppress(subprocess.TimeoutExpired):
-                        proc.wait(timeout=wait_s)
-                        break
-                else:
-                    raise subprocess.TimeoutExpired(proc.args, self.stop_timeout)
+                guard.wait(timeout=self.stop_timeout + 10.0)
             except subprocess.TimeoutExpired:
-                for pid in [*_children(proc.pid), *children]:
-                    with contextlib.suppress(ProcessLookupError):
-                        os.kill(pid, signal.SIGKILL)
-                proc.kill()
-                proc.wait(timeout=self.stop_timeout)
-        if self._log is not None:
-            self._log.unlink(missing_ok=True)
-            self._log = None
+                if self._pid is not None:
+                    for pid in [*_children(self._pid), self._pid]:
+                        with contextlib.suppress(ProcessLookupError):
+                            os.kill(pid, signal.SIGKILL)
+                guard.kill()
+                guard.wait(timeout=self.stop_timeout)
+            if guard.stdout is not None:
+                guard.stdout.close()
+        self._pid = None
+        if self._log_dir is not None:
+            shutil.rmtree(self._log_dir, ignore_errors=True)
+            self._log_dir = None
 
     def __enter__(self) -> RosCore:
         return self.start()
@@ -198,3 +294,11 @@ class RosCore:
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
         self.stop()
+
+
+def _children(pid: int) -> list[int]:
+    try:
+        text = Path(f"/proc/{pid}/task/{pid}/children").read_text()
+    except OSError:
+        return []
+    return [int(p) for p in text.split()]

@@ -98,6 +98,8 @@ def plan_movej(q0: Sequence[float] | FloatArray, q1: Sequence[float] | FloatArra
     a_cap = np.minimum(a, np.asarray(a_max, dtype=float))[moving]
     s_vel = float(np.min(v_cap / dist[moving]))
     s_acc = float(np.min(a_cap / dist[moving]))
+    if s_vel <= 0.0 or s_acc <= 0.0:  # v or a so small that the rate underflows: a move that never ends
+        return MoveJ(start, end, s_vel, s_acc, math.inf, math.inf)
     if s_vel * s_vel / s_acc >= 1.0:  # cruise speed not reached within the unit path: a triangle
         t_acc = math.sqrt(1.0 / s_acc)
         return MoveJ(start, end, s_acc * t_acc, s_acc, t_acc, 2.0 * t_acc)

@@ -16,7 +16,21 @@ The node speaks the course's topics and messages exactly (:mod:`ur3hanoi.ros.msg
 Real time: one world step per control period on the wall clock (absolute schedule; a late cycle is caught up by
 the following ones, so world time never drifts from wall time). The worst lag of a cycle's start behind its
 schedule is reported. A roscore is started when none answers at ``ROS_MASTER_URI`` (:mod:`ur3hanoi.ros.master`)
-and stopped on exit.
+and stopped on exit, or when the station dies (:mod:`ur3hanoi.ros.guard`).
+
+A flood cannot stall the loop: the ROS callbacks only append to a bounded inbox (:data:`INBOX_MAX` messages;
+more are refused as "inbox full" and counted); each cycle handles at most what the inbox held when it started;
+refusals and topic messages are logged through :class:`~ur3hanoi.ros.lograte.RateLimitedLog` (at most one line per
+topic and second, with counts); the records are bounded (:mod:`ur3hanoi.ros.driver`, world events), so memory and
+the report do not grow with the number of commands.
+
+Listening: the station and the roscore it starts bind and advertise ``host`` (``ROS_IP``), by default
+``127.0.0.1``: nothing on the lab network can reach them. ``--host ADDR`` (this machine's address on the lab
+network) opens them; a master on another machine needs it. ``ROS_IP``/``ROS_HOSTNAME`` of the environment are
+not used.
+
+Output: the ready line and every info line go to ``info`` (the CLI: stderr); standard output carries only the
+JSON report when there is no ``--report`` file.
 
 ``--frames``/``--video`` render in a separate low-priority process (:mod:`ur3hanoi.ros.render`), which drops
 frames rather than stall the loop.
@@ -31,13 +45,15 @@ from __future__ import annotations
 
 import bisect
 import gc
+import ipaddress
 import json
 import math
 import os
-import queue
 import signal
 import sys
+import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,7 +63,10 @@ from typing import Any
 from ur3hanoi.ros.errors import CommandError, RosError
 
 READY_LINE = "ur3hanoi ros-station: ready"
-"""Printed (and flushed) on stdout once the node is up: scripts wait for it."""
+"""Written (and flushed) on stderr once the node is up: scripts wait for it."""
+
+INBOX_MAX = 200
+"""Messages the callbacks may leave for the control loop; more are refused (counted, logged once a second)."""
 
 
 @dataclass(frozen=True)
@@ -66,6 +85,8 @@ class StationOptions:
         frames, video: offscreen rendering (PNG folder or MP4), as in ``ur3hanoi solve``.
         duration_s: stop by itself after this wall time [s], or None (until SIGINT/SIGTERM).
         master_uri: ROS master (None: ``ROS_MASTER_URI``, else http://localhost:11311).
+        host: address the station and the roscore it starts listen on and advertise (``ROS_IP``); the default
+            127.0.0.1 keeps them on this machine.
     """
 
     calibration: str = "lab_sim"
@@ -80,6 +101,7 @@ class StationOptions:
     video: Path | None = None
     duration_s: float | None = None
     master_uri: str | None = None
+    host: str = "127.0.0.1"
 
 
 LAG_BINS_MS: tuple[float, ...] = (1.0, 2.0, 4.0, 8.0, 16.0, 32.0)
@@ -115,22 +137,31 @@ class LoopTiming:
                                      f">={LAG_BINS_MS[-1]:g}": self.histogram[-1]}}
 
 
+_TOPIC_LOG = {"command": "ur3/command rejected, the arm does not move", "spawn": "ur3hanoi/spawn",
+              "remove": "ur3hanoi/remove_block"}
+"""Prefix of the log lines about each topic's messages."""
+
+
 class RosStation:
     """The ``ros-station`` node (see the module docstring). :meth:`run` blocks until stopped.
 
     Args:
         options: what to run.
-        out: where the ready line and the summary go (default: print to stdout, flushed).
+        out: where the ready line and info lines go (default: print to stderr, flushed).
+        report_out: where the JSON report goes without ``options.report`` (default: print to stdout, flushed).
     """
 
-    def __init__(self, options: StationOptions, out: Callable[[str], None] | None = None) -> None:
+    def __init__(self, options: StationOptions, out: Callable[[str], None] | None = None,
+                 report_out: Callable[[str], None] | None = None) -> None:
         from ur3hanoi.ros.driver import StationDriver
-        from ur3hanoi.ros.master import MasterUri, master_uri_from_env
+        from ur3hanoi.ros.lograte import RateLimitedLog
+        from ur3hanoi.ros.master import MasterUri, is_loopback, master_uri_from_env
         from ur3hanoi.ros.world import StationWorld, WorldConfig
         from ur3hanoi.station import load_station
 
         self.options = opts = options
-        self.out = out if out is not None else (lambda s: print(s, flush=True))
+        self.out = out if out is not None else (lambda s: print(s, file=sys.stderr, flush=True))
+        self.report_out = report_out if report_out is not None else (lambda s: print(s, flush=True))
         self.station = load_station(opts.calibration)
         n_blocks = self.station.n_heights if opts.n_blocks is None else opts.n_blocks
         if not 1 <= n_blocks <= self.station.n_heights:
@@ -143,11 +174,22 @@ class RosStation:
         self.world = StationWorld(self.station, opts.start, n_blocks, opts.removed, config, opts.drop_on_grasp)
         self.driver = StationDriver(self.world)
         self.master_uri = opts.master_uri or master_uri_from_env()
-        MasterUri.parse(self.master_uri)
+        master = MasterUri.parse(self.master_uri)
+        try:
+            ipaddress.ip_address(opts.host)
+        except ValueError:
+            raise RosError(f"host {opts.host!r} is invalid: expected this machine's IP address (ROS_IP), e.g. "
+                           "127.0.0.1 (default, this machine only) or its address on the lab network") from None
+        if not master.is_local and is_loopback(opts.host):
+            raise RosError(f"the ROS master {self.master_uri} is on another machine, which cannot reach a station "
+                           "listening on loopback only: give --host ADDR, this machine's address on the lab network")
         self.timing = LoopTiming(config.period_s)
         self.reports_written = 0
         self.roscore_started = False
-        self._inbox: queue.SimpleQueue[tuple[str, Any]] = queue.SimpleQueue()
+        self._inbox: deque[tuple[str, Any]] = deque()
+        self._overflow: dict[str, int] = {}
+        self._overflow_lock = threading.Lock()
+        self.log = RateLimitedLog(self._emit)
         self._stop = False
         self._dump = False
         self._wall0 = 0.0
@@ -157,42 +199,69 @@ class RosStation:
         self._frames: dict[str, int] | None = None
 
     # ---------------------------------------------------------------------------------------------- callbacks
-    def _on_command(self, msg: Any) -> None:
-        self._inbox.put(("command", msg))
+    def _offer(self, kind: str, payload: Any) -> None:
+        """Called in rospy's threads: hand a message to the control loop, or count it when the inbox is full."""
+        if len(self._inbox) < INBOX_MAX:
+            self._inbox.append((kind, payload))
+        else:
+            with self._overflow_lock:
+                self._overflow[kind] = self._overflow.get(kind, 0) + 1
+
+    def on_command(self, msg: Any) -> None:
+        """The ``ur3/command`` callback (any thread): the message waits in the inbox for :meth:`cycle`."""
+        self._offer("command", msg)
 
     def _on_spawn(self, msg: Any) -> None:
-        self._inbox.put(("spawn", msg.data))
+        self._offer("spawn", msg.data)
 
     def _on_remove(self, msg: Any) -> None:
-        self._inbox.put(("remove", msg.data))
+        self._offer("remove", msg.data)
+
+    def _emit(self, level: str, text: str) -> None:
+        rospy = self._rospy
+        if rospy is None:
+            self.out(text)
+        else:
+            {"info": rospy.loginfo, "warn": rospy.logwarn}.get(level, rospy.logerr)(text)
 
     def _drain(self) -> None:
-        """Handle what the callbacks received, in order, in the control thread (the world is single-threaded)."""
-        rospy = self._rospy
-        while True:
-            try:
-                kind, payload = self._inbox.get_nowait()
-            except queue.Empty:
-                return
+        """Handle what the callbacks received, in order, in the control thread (the world is single-threaded):
+        at most what the inbox held when the cycle started, so a flood cannot hold the loop."""
+        with self._overflow_lock:
+            overflow, self._overflow = self._overflow, {}
+        for kind, n in overflow.items():
+            reason = f"the station's inbox is full ({INBOX_MAX} messages not yet handled): message dropped"
+            for _ in range(n):
+                if kind == "command":
+                    self.driver.refuse(reason)
+                self.log.log(_TOPIC_LOG[kind], "error", reason)
+        for _ in range(len(self._inbox)):
+            kind, payload = self._inbox.popleft()
             if kind == "command":
                 try:
                     self.driver.submit(payload.destination, payload.v, payload.a, payload.io_0)
                 except CommandError as exc:
-                    rospy.logerr(f"ur3/command rejected, the arm does not move: {exc}")
+                    self.log.log(_TOPIC_LOG[kind], "error", str(exc))
             elif kind == "spawn":
                 n = self.station.n_towers
                 if isinstance(payload, int) and 1 <= payload <= n:
                     self.world.spawn(payload - 1)
-                    rospy.loginfo(f"ur3hanoi/spawn: {self.world.n_blocks} blocks respawned on tower {payload}")
+                    self.log.log(_TOPIC_LOG[kind], "info", f"{self.world.n_blocks} blocks respawned on tower {payload}")
                 else:
-                    rospy.logerr(f"ur3hanoi/spawn: tower {payload!r} is invalid: expected 1..{n}")
+                    self.log.log(_TOPIC_LOG[kind], "error", f"tower {payload!r} is invalid: expected 1..{n}")
             else:
                 n = self.world.n_blocks
                 if isinstance(payload, int) and 1 <= payload <= n:
                     what = self.world.remove(payload - 1)
-                    rospy.logwarn(f"ur3hanoi/remove_block: block {payload} {what}")
+                    self.log.log(_TOPIC_LOG[kind], "warn", f"block {payload} {what}")
                 else:
-                    rospy.logerr(f"ur3hanoi/remove_block: block {payload!r} is invalid: expected 1..{n}")
+                    self.log.log(_TOPIC_LOG[kind], "error", f"block {payload!r} is invalid: expected 1..{n}")
+        self.log.flush()
+
+    def cycle(self) -> None:
+        """One control period of the node, without ROS: handle the inbox, then one driver and world step."""
+        self._drain()
+        self.driver.cycle()
 
     def _signal(self, signum: int, _frame: FrameType | None) -> None:
         if signum == signal.SIGUSR1:
@@ -205,7 +274,7 @@ class RosStation:
         """The JSON report (see the module docstring); numbering from 1."""
         w, st = self.world, self.station
         suction_kinds = {"suction_on", "suction_off", "grasp", "release"}
-        events = [e.as_dict() for e in w.events]
+        events = [e.as_dict() for e in w.events]  # the last EVENTS_KEPT; counts of all in "event_counts"
         wall = (self._wall_end or time.perf_counter()) - self._wall0 if self._wall0 else 0.0
         holding = w.holding
         return {
@@ -223,6 +292,8 @@ class RosStation:
             "suction_events": [e for e in events if e["kind"] in suction_kinds],
             "faults": [e for e in events if e["kind"] in ("removed", "dropped")],
             "spawns": [e for e in events if e["kind"] == "spawn"],
+            "event_counts": dict(w.event_counts),
+            "log_lines": self.log.lines,
             "final": {
                 "q": [round(float(x), 9) for x in w.q],
                 "ready": self.driver.ready,
@@ -246,14 +317,14 @@ class RosStation:
         if self.options.report is not None:
             atomic_write(self.options.report, text)
         else:
-            self.out(text.rstrip("\n"))
+            self.report_out(text.rstrip("\n"))
         return report
 
     # --------------------------------------------------------------------------------------------------- run
     def run(self) -> dict[str, Any]:
         """Start (or use) the master, run the node until SIGINT/SIGTERM or ``duration_s``; returns the report."""
         from ur3hanoi.ros.env import import_rospy, import_std_msgs
-        from ur3hanoi.ros.master import RosCore
+        from ur3hanoi.ros.master import RosCore, listen_env
         from ur3hanoi.ros.msgs import load_messages
 
         msgs = load_messages()
@@ -261,22 +332,30 @@ class RosStation:
         std_msgs = import_std_msgs()
         handled = (signal.SIGINT, signal.SIGTERM, signal.SIGUSR1)
         previous = {s: signal.signal(s, self._signal) for s in handled}
+        # rospy's receiving threads hold the GIL for each message they decode: with the default 5 ms switch
+        # interval a flood of messages can keep the control loop waiting most of an 8 ms period.
+        switch = sys.getswitchinterval()
+        sys.setswitchinterval(min(switch, 0.0005))
         sink: Any = None
         try:
             sink = self._sink = self._open_sink()  # before rospy starts its threads
-            with RosCore(self.master_uri) as core:
+            with RosCore(self.master_uri, host=self.options.host) as core:
                 self.roscore_started = core.started
-                os.environ["ROS_MASTER_URI"] = self.master_uri  # rospy reads it from the environment
+                # rospy reads these from the environment: the master, and the address to bind and advertise.
+                env = listen_env(dict(os.environ, ROS_MASTER_URI=self.master_uri), self.options.host)
+                os.environ.pop("ROS_HOSTNAME", None)
+                os.environ.update(env)
                 rospy.init_node("ur3hanoi_station", argv=[sys.argv[0]], disable_signals=True)
                 pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
                 pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
-                rospy.Subscriber("/ur3/command", msgs.command, self._on_command, queue_size=100)
+                rospy.Subscriber("/ur3/command", msgs.command, self.on_command, queue_size=100)
                 rospy.Subscriber("/ur3hanoi/spawn", std_msgs.Int32, self._on_spawn, queue_size=10)
                 rospy.Subscriber("/ur3hanoi/remove_block", std_msgs.Int32, self._on_remove, queue_size=10)
                 try:
                     self._loop(msgs, pub_pos, pub_grip, sink)
                 finally:
                     self._wall_end = time.perf_counter()
+                    self.log.flush(force=True)
                     rospy.signal_shutdown("ur3hanoi ros-station stopped")
                 if sink is not None:
                     self._frames = sink.close()
@@ -286,6 +365,7 @@ class RosStation:
                 sink.close()
             for s, handler in previous.items():
                 signal.signal(s, handler)
+            sys.setswitchinterval(switch)
         return report
 
     def _open_sink(self) -> Any:
@@ -311,8 +391,7 @@ class RosStation:
         while not self._stop and not self._rospy.is_shutdown():
             now = time.perf_counter()
             self.timing.add(now - next_t)
-            self._drain()
-            self.driver.cycle()
+            self.cycle()
             fb = w.feedback()
             pub_pos.publish(msgs.position(position=[float(x) for x in w.q], isReady=self.driver.ready))
             pub_grip.publish(msgs.gripper_input(DIGIN=fb.digin, AIN0=fb.ain0, AIN1=0.0))

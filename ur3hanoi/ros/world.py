@@ -13,6 +13,7 @@ blocks are parked on the floor beside the table ("off-grid"), so a respawn bring
 
 from __future__ import annotations
 
+from collections import Counter, deque
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -37,6 +38,10 @@ from ur3hanoi.sim import (
     start_slots,
 )
 from ur3hanoi.station import Station
+
+EVENTS_KEPT = 200
+"""How many of the latest suction and block events the world keeps (a flood of commands toggling the suction must
+not grow memory); :attr:`StationWorld.event_counts` counts every event."""
 
 
 @dataclass(frozen=True)
@@ -118,7 +123,8 @@ class StationWorld:
         kv = -m.actuator_biasprm[self._act, 2]
         self._ff = kv / kp  # velocity feed-forward [s]: servo force kp (q_ref - q) + kv (qd_ref - qd)
         self.cup = SuctionCup(self.scene, cfg.suction, seed=cfg.seed)
-        self.events: list[WorldEvent] = []
+        self.events: deque[WorldEvent] = deque(maxlen=EVENTS_KEPT)  # the last ones; counts of all below
+        self.event_counts: Counter[str] = Counter()
         self._centers = slot_centers(station)
         floor = m.geom("floor")
         floor_z = float(m.geom_pos[floor.id][2])
@@ -176,6 +182,10 @@ class StationWorld:
         """The ``gripper_input`` now (``DIGIN`` bit 0, ``AIN0`` [V] with seeded noise)."""
         return self.cup.feedback()
 
+    def _event(self, event: WorldEvent) -> None:
+        self.events.append(event)
+        self.event_counts[event.kind] += 1
+
     # ------------------------------------------------------------------------------------------------ motion
     def begin(self, command: MoveCommand) -> MoveJ:
         """Switch the suction to ``command.io_0`` and start its ``movej`` from the current reference."""
@@ -196,9 +206,9 @@ class StationWorld:
         self.cup.command(on)
         if on:
             self.cup.grasp_enabled = True
-        self.events.append(WorldEvent(self.time, "suction_on" if on else "suction_off"))
+        self._event(WorldEvent(self.time, "suction_on" if on else "suction_off"))
         if not on and held is not None:
-            self.events.append(WorldEvent(self.time, "release", held))
+            self._event(WorldEvent(self.time, "release", held))
         self._attached = self.cup.attached
 
     def step(self) -> None:
@@ -218,7 +228,7 @@ class StationWorld:
         self._servo_prev = servo
         self.cup.update()
         if self.cup.attached is not None and self._attached is None:
-            self.events.append(WorldEvent(self.time, "grasp", self.cup.attached))
+            self._event(WorldEvent(self.time, "grasp", self.cup.attached))
             if self._drop_on_grasp is not None and self._grasps == self._drop_on_grasp:
                 self._drop_armed = True
             self._grasps += 1
@@ -229,7 +239,7 @@ class StationWorld:
             self.cup.grasp_enabled = False  # a cup that lost its seal does not catch the falling block again
             self._attached = None
             if lost is not None:
-                self.events.append(WorldEvent(self.time, "dropped", lost))
+                self._event(WorldEvent(self.time, "dropped", lost))
         mujoco.mj_step(m, d, nstep=self.nsub)
 
     # ------------------------------------------------------------------------------------------------ blocks
@@ -256,8 +266,9 @@ class StationWorld:
         for b in range(self.n_blocks):
             self._set_block(b, self._centers[slots[b]] if b in slots else self._park[b])
         mujoco.mj_forward(self.scene.model, self.scene.data)
-        self.events.append(WorldEvent(self.time, "spawn", tower=tower))
-        self.events += [WorldEvent(self.time, "removed", b) for b in sorted(self.removed)]
+        self._event(WorldEvent(self.time, "spawn", tower=tower))
+        for b in sorted(self.removed):
+            self._event(WorldEvent(self.time, "removed", b))
 
     def remove(self, block: int) -> str:
         """Take ``block`` (0-based) away: park it off-grid; if the suction holds it, it is lost (a drop).
@@ -276,7 +287,7 @@ class StationWorld:
         self.removed.add(block)
         self._set_block(block, self._park[block])
         mujoco.mj_forward(self.scene.model, self.scene.data)
-        self.events.append(WorldEvent(self.time, kind, block))
+        self._event(WorldEvent(self.time, kind, block))
         return kind
 
     def blocks(self) -> tuple[FinalBlock, ...]:
