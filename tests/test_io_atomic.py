@@ -9,7 +9,6 @@ import os
 import signal
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -17,7 +16,8 @@ import pytest
 import yaml
 
 from ur3hanoi.errors import OutputError
-from ur3hanoi.io.atomic import atomic_write, check_output, locked_output
+from ur3hanoi.io import atomic
+from ur3hanoi.io.atomic import atomic_write, check_output, lock_file_name, locked_output
 from ur3hanoi.io.yaml_loader import parse_yaml
 
 
@@ -95,18 +95,23 @@ def test_refused_outputs_write_nothing(tmp_path: Path, kind: str, match: str) ->
     [
         ("fsync", OSError(errno.ENOSPC, "No space left on device"), "No space left on device; nothing was written"),
         ("replace", OSError(errno.EXDEV, "Invalid cross-device link"), "Invalid cross-device link"),
-        ("mkstemp", OSError(errno.EROFS, "Read-only file system"), "Read-only file system"),
+        ("open", OSError(errno.EROFS, "Read-only file system"), "Read-only file system"),
     ],
 )
+@pytest.mark.parametrize("anonymous", [True, False], ids=["O_TMPFILE", "named"])
 def test_failed_write_leaves_old_file_and_no_temp(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, patch: str,
-                                                  exc: OSError, match: str) -> None:
+                                                  exc: OSError, match: str, anonymous: bool) -> None:
     out = tmp_path / "a.txt"
     out.write_text("old\n")
+    monkeypatch.setattr(atomic, "ANONYMOUS_TEMPORARIES", anonymous)
+    real = getattr(os, patch)
 
     def fail(*args: Any, **kwargs: Any) -> Any:
+        if patch == "open" and not args[1] & (os.O_CREAT | os.O_TMPFILE):  # directories still open
+            return real(*args, **kwargs)
         raise exc
 
-    monkeypatch.setattr(tempfile if patch == "mkstemp" else os, patch, fail)
+    monkeypatch.setattr(os, patch, fail)
     with pytest.raises(OutputError, match=match):
         atomic_write(out, "new\n")
     assert out.read_text() == "old\n"
@@ -217,14 +222,16 @@ def test_sigkill_mid_write_leaves_no_temporary_file(tmp_path: Path) -> None:
     out.write_text("old\n")
     _kill_mid_write(out, "anonymous")  # O_TMPFILE: the text never had a name
     assert out.read_text() == "old\n"
-    assert _listing(tmp_path) == ["lab2_data.yaml"]
+    assert _listing(tmp_path) == sorted(["lab2_data.yaml", lock_file_name("lab2_data.yaml")])  # the held lock...
+    atomic_write(tmp_path / "other.txt", "x\n")  # ...is removed by the next write into the directory
+    assert _listing(tmp_path) == ["lab2_data.yaml", "other.txt"]
 
 
 def test_a_later_write_removes_the_named_temporary_of_a_killed_writer(tmp_path: Path) -> None:
     out = tmp_path / "lab2_data.yaml"
     out.write_text("old\n")
     _kill_mid_write(out, "named")  # the fallback where O_TMPFILE is unsupported: a named temporary is left...
-    left = [n for n in _listing(tmp_path) if n != "lab2_data.yaml"]
+    left = [n for n in _listing(tmp_path) if n not in ("lab2_data.yaml", lock_file_name("lab2_data.yaml"))]
     assert len(left) == 1 and out.read_text() == "old\n"
     live = tmp_path / left[0].replace(left[0].split("-")[1], str(os.getpid()), 1)  # one of a running process
     live.write_text("busy\n")
@@ -286,13 +293,13 @@ def test_links_of_the_caller_or_the_directory_owner_are_followed(tmp_path: Path)
 def test_a_lock_file_of_another_user_is_a_clear_error_not_a_wait(tmp_path: Path) -> None:
     out = tmp_path / "lab2_data.yaml"
     out.write_text("old\n")
-    lock = tmp_path / ".lab2_data.yaml.lock"
+    lock = tmp_path / lock_file_name("lab2_data.yaml")
     lock.write_text("")
     os.chown(lock, OTHER_UID, OTHER_UID)
     holder = os.open(lock, os.O_RDWR)
     fcntl.flock(holder, fcntl.LOCK_EX)  # the other user's writer holds it
     try:
-        with pytest.raises(OutputError, match=r"lock file .*\.lab2_data\.yaml\.lock belongs to .*uid 65534"):
+        with pytest.raises(OutputError, match=r"the lock file .*\.lock belongs to .*uid 65534"):
             atomic_write(out, "new\n")
     finally:
         os.close(holder)
