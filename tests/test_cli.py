@@ -343,9 +343,91 @@ def test_solve_render_outputs_are_checked_before_simulating(tmp_path: Path,
     blocker = tmp_path / "file"
     blocker.write_text("x")
     assert main(["solve", "--start", "1", "--end", "3", "--frames", str(blocker / "frames")]) == 2
-    assert "cannot write frames into" in _one_error_line(capsys.readouterr().err)
+    assert f"cannot write {blocker / 'frames'}: " in _one_error_line(capsys.readouterr().err)
     assert _listing(tmp_path) == ["file"]
 
 
 def _listing(directory: Path) -> list[str]:
     return sorted(p.name for p in directory.iterdir())
+
+
+# ------------------------------------------------------------------------------ outputs: atomic and safe
+
+OTHER_UID = 65534  # nobody
+
+
+def _planted_link(tmp_path: Path, name: str) -> tuple[Path, Path]:
+    """A victim file of the caller and a link to it planted by another user in a shared sticky directory."""
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious\n")
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o1777)
+    link = shared / name
+    link.symlink_to(victim)
+    os.lchown(link, OTHER_UID, OTHER_UID)
+    return link, victim
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="planting another user's link needs root (os.lchown)")
+@pytest.mark.parametrize("command", ["plan --csv", "tables -o", "calibrate -o", "ros-station --report"])
+def test_no_output_follows_a_link_planted_in_a_sticky_directory(tmp_path: Path, command: str,
+                                                                capsys: pytest.CaptureFixture[str]) -> None:
+    link, victim = _planted_link(tmp_path, "out")
+    argv = {
+        "plan --csv": ["plan", "--start", "1", "--end", "3", "--no-collision", "--csv", str(link)],
+        "tables -o": ["tables", "lab_sim", "--key", "sim_pos", "-o", str(link)],
+        "calibrate -o": ["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos", "--base", "lab_real",
+                         "-o", str(link)],
+        "ros-station --report": ["ros-station", "--duration", "0.5", "--master", "http://127.0.0.1:9/",
+                                 "--report", str(link)],
+    }[command]
+    assert main(argv) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert f"cannot write {link}: {link} is a symbolic link of user 'nobody' (uid 65534) in the shared sticky" in err
+    assert victim.read_text() == "precious\n"
+    assert sorted(p.name for p in link.parent.iterdir()) == ["out"]
+
+
+@pytest.mark.parametrize("argv", [
+    ["tables", "lab_sim", "--key", "sim_pos", "-o", "-"],
+    ["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos", "--base", "lab_real", "-o", "-"],
+    ["plan", "--start", "1", "--end", "3", "--csv", "-"],
+    ["solve", "--start", "1", "--end", "3", "--video", "-"],
+    ["solve", "--start", "1", "--end", "3", "--frames", "-"],
+])
+def test_dash_as_an_output_is_refused_in_one_line(argv: list[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert "cannot write -: standard output is not supported for this output: give a file name (./- for" in err
+    assert _listing(tmp_path) == []
+
+
+@pytest.mark.parametrize(("target", "expected"), [
+    ("/proc/x.mp4", "the directory /proc does not accept new files"),
+    ("{tmp}/missing/x.mp4", "missing does not exist"),
+])
+@pytest.mark.parametrize("option", ["--video", "--frames"])
+def test_unwritable_render_outputs_fail_before_the_run(tmp_path: Path, target: str, expected: str, option: str,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    target = target.format(tmp=tmp_path)
+    if option == "--frames":
+        target = target.removesuffix(".mp4")
+    assert main(["solve", "--start", "1", "--end", "3", "--blocks", "1", option, target]) == 2
+    err = _one_error_line(capsys.readouterr().err)  # no progress line: nothing was simulated
+    assert err.startswith(f"ur3hanoi: error: cannot write {target}: ") and expected in err
+    assert _listing(tmp_path) == []
+
+
+def test_a_video_named_like_an_ffmpeg_option_is_a_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    import imageio_ffmpeg
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["solve", "--start", "1", "--end", "3", "--blocks", "1", "--video=-x.mp4", "--size", "32x24",
+                 "--fps", "5", "--to", "0.6"]) == 0
+    assert "wrote 4 frames to -x.mp4" in capsys.readouterr().out
+    assert imageio_ffmpeg.count_frames_and_secs(str(tmp_path / "-x.mp4"))[0] == 4
+    assert _listing(tmp_path) == ["-x.mp4"]
