@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -17,6 +18,7 @@ from ur3hanoi.cli.options import DWELL, RATE, SEED, SPEED, option
 from ur3hanoi.errors import PlanError, SuctionFaultError, Ur3HanoiError
 
 from .conftest import LAB_REAL, LAB_SIM, REPO
+from .ros_support import free_port, requires_ros, ros_env, run, ur3hanoi_cmd
 
 LAB_TABLE = REPO / "tables/lab2_data.yaml"
 
@@ -431,3 +433,14 @@ def test_a_video_named_like_an_ffmpeg_option_is_a_file(tmp_path: Path, monkeypat
     assert "wrote 4 frames to -x.mp4" in capsys.readouterr().out
     assert imageio_ffmpeg.count_frames_and_secs(str(tmp_path / "-x.mp4"))[0] == 4
     assert _listing(tmp_path) == ["-x.mp4"]
+
+
+@requires_ros
+def test_ros_station_report_dash_is_standard_output(tmp_path: Path) -> None:
+    env = ros_env(free_port(), tmp_path)
+    result = run(ur3hanoi_cmd("ros-station", "--duration", "1", "--report", "-"), env, 120.0)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    report = json.loads("\n".join(lines[lines.index("{"):]))  # the JSON report (info lines may precede it)
+    assert report["control"]["cycles"] > 0 and report["reports_written"] == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ros_home"]  # no file named '-'
