@@ -16,8 +16,8 @@ import pytest
 import yaml
 
 from ur3hanoi.errors import OutputError
-from ur3hanoi.io import atomic
 from ur3hanoi.io.atomic import atomic_write, check_output, lock_file_name, locked_output
+from ur3hanoi.io.atomic import files as atomic_files
 from ur3hanoi.io.yaml_loader import parse_yaml
 
 
@@ -103,7 +103,7 @@ def test_failed_write_leaves_old_file_and_no_temp(tmp_path: Path, monkeypatch: p
                                                   exc: OSError, match: str, anonymous: bool) -> None:
     out = tmp_path / "a.txt"
     out.write_text("old\n")
-    monkeypatch.setattr(atomic, "ANONYMOUS_TEMPORARIES", anonymous)
+    monkeypatch.setattr(atomic_files, "ANONYMOUS_TEMPORARIES", anonymous)
     real = getattr(os, patch)
 
     def fail(*args: Any, **kwargs: Any) -> Any:
@@ -195,8 +195,8 @@ def test_file_names_up_to_name_max_are_written(tmp_path: Path, n_bytes: int) -> 
 _KILLED_WRITER = """
 import os, sys
 from ur3hanoi.io import atomic
-atomic.ANONYMOUS_TEMPORARIES = sys.argv[2] == "anonymous"
-real_fsync = os.fsync
+from ur3hanoi.io.atomic import files
+files.ANONYMOUS_TEMPORARIES = sys.argv[2] == "anonymous"
 def stall(fd):
     print("writing", flush=True)  # the text is in the temporary file, not yet renamed: wait to be killed
     import time
