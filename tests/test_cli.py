@@ -444,3 +444,33 @@ def test_ros_station_report_dash_is_standard_output(tmp_path: Path) -> None:
     report = json.loads("\n".join(lines[lines.index("{"):]))  # the JSON report (info lines may precede it)
     assert report["control"]["cycles"] > 0 and report["reports_written"] == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ros_home"]  # no file named '-'
+
+
+@pytest.mark.parametrize("option", ["--video", "--frames"])
+def test_ctrl_c_during_a_rendered_solve_leaves_the_old_output(option: str, tmp_path: Path,
+                                                              monkeypatch: pytest.MonkeyPatch,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    from ur3hanoi.cli import solve
+
+    real = solve._ProgressLines.__call__
+
+    def interrupt_halfway(self: solve._ProgressLines, fraction: float, label: str) -> None:
+        real(self, fraction, label)
+        if fraction >= 0.5 and getattr(self.recorder, "count", 0) > 0:  # frames rendered: then Ctrl-C
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(solve._ProgressLines, "__call__", interrupt_halfway)
+    out = tmp_path / ("run.mp4" if option == "--video" else "frames")
+    if option == "--video":
+        out.write_bytes(b"the previous video")
+    else:
+        out.mkdir()
+        (out / "frame_00000.png").write_bytes(b"the previous frame")
+    assert main(["solve", "--start", "1", "--end", "3", "--blocks", "1", option, str(out), "--size", "32x24",
+                 "--fps", "5"]) == 130
+    assert "interrupted" in capsys.readouterr().err
+    if option == "--video":
+        assert out.read_bytes() == b"the previous video"
+    else:
+        assert {p.name: p.read_bytes() for p in out.iterdir()} == {"frame_00000.png": b"the previous frame"}
+    assert _listing(tmp_path) == [out.name]
