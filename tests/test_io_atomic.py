@@ -314,3 +314,12 @@ def test_outputs_that_cannot_be_written_are_refused_before_writing(path: str, ma
     with pytest.raises(OutputError, match=match) as info:
         check_output(path)
     assert "\n" not in str(info.value)
+
+
+def test_a_removed_working_directory_is_one_line(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    with pytest.raises(OutputError, match="the current directory is unusable"):
+        check_output("x.txt")

@@ -52,7 +52,10 @@ def resolve(path: str | Path) -> tuple[Path, str]:
     if shown == "-":
         raise refuse(shown, "standard output is not supported for this output: give a file name (./- for a file "
                              "named '-')")
-    current = "/" if shown.startswith("/") else os.getcwd()
+    try:
+        current = "/" if shown.startswith("/") else os.getcwd()
+    except OSError as exc:  # the working directory was removed
+        raise refuse(shown, f"the current directory is unusable ({exc.strerror})") from None
     parts = list(reversed(shown.split("/")))  # a stack: next component last
     links = 0
     while parts:
