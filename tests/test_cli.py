@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -17,6 +18,7 @@ from ur3hanoi.cli.options import DWELL, RATE, SEED, SPEED, option
 from ur3hanoi.errors import PlanError, SuctionFaultError, Ur3HanoiError
 
 from .conftest import LAB_REAL, LAB_SIM, REPO
+from .ros_support import free_port, requires_ros, ros_env, run, ur3hanoi_cmd
 
 LAB_TABLE = REPO / "tables/lab2_data.yaml"
 
@@ -361,7 +363,7 @@ def test_solve_render_outputs_are_checked_before_simulating(tmp_path: Path,
     blocker = tmp_path / "file"
     blocker.write_text("x")
     assert main(["solve", "--start", "1", "--end", "3", "--frames", str(blocker / "frames")]) == 2
-    assert "cannot write frames into" in _one_error_line(capsys.readouterr().err)
+    assert f"cannot write {blocker / 'frames'}: " in _one_error_line(capsys.readouterr().err)
     assert _listing(tmp_path) == ["file"]
 
 
@@ -470,3 +472,126 @@ def test_yaml11_readings_in_a_taught_file_exit_2_quoting_the_source(old: str, ne
     assert (message or "field 'points[3].height' = 010 (line 10) is ambiguous: YAML 1.1 reads 010 as the octal "
                        "number 8; write 10 or 8, whichever you mean, without the leading zero") in err
     assert not out.exists()
+
+
+# ------------------------------------------------------------------------------ outputs: atomic and safe
+
+OTHER_UID = 65534  # nobody
+
+
+def _planted_link(tmp_path: Path, name: str) -> tuple[Path, Path]:
+    """A victim file of the caller and a link to it planted by another user in a shared sticky directory."""
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious\n")
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o1777)
+    link = shared / name
+    link.symlink_to(victim)
+    os.lchown(link, OTHER_UID, OTHER_UID)
+    return link, victim
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="planting another user's link needs root (os.lchown)")
+@pytest.mark.parametrize("command", ["plan --csv", "tables -o", "calibrate -o", "ros-station --report"])
+def test_no_output_follows_a_link_planted_in_a_sticky_directory(tmp_path: Path, command: str,
+                                                                capsys: pytest.CaptureFixture[str]) -> None:
+    link, victim = _planted_link(tmp_path, "out")
+    argv = {
+        "plan --csv": ["plan", "--start", "1", "--end", "3", "--no-collision", "--csv", str(link)],
+        "tables -o": ["tables", "lab_sim", "--key", "sim_pos", "-o", str(link)],
+        "calibrate -o": ["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos", "--base", "lab_real",
+                         "-o", str(link)],
+        "ros-station --report": ["ros-station", "--duration", "0.5", "--master", "http://127.0.0.1:9/",
+                                 "--report", str(link)],
+    }[command]
+    assert main(argv) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert f"cannot write {link}: {link} is a symbolic link of user 'nobody' (uid 65534) in the shared sticky" in err
+    assert victim.read_text() == "precious\n"
+    assert sorted(p.name for p in link.parent.iterdir()) == ["out"]
+
+
+@pytest.mark.parametrize("argv", [
+    ["tables", "lab_sim", "--key", "sim_pos", "-o", "-"],
+    ["calibrate", "--from-table", str(LAB_TABLE), "--key", "real_pos", "--base", "lab_real", "-o", "-"],
+    ["plan", "--start", "1", "--end", "3", "--csv", "-"],
+    ["solve", "--start", "1", "--end", "3", "--video", "-"],
+    ["solve", "--start", "1", "--end", "3", "--frames", "-"],
+])
+def test_dash_as_an_output_is_refused_in_one_line(argv: list[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert "cannot write -: standard output is not supported for this output: give a file name (./- for" in err
+    assert _listing(tmp_path) == []
+
+
+@pytest.mark.parametrize(("target", "expected"), [
+    ("/proc/x.mp4", "the directory /proc does not accept new files"),
+    ("{tmp}/missing/x.mp4", "missing does not exist"),
+])
+@pytest.mark.parametrize("option", ["--video", "--frames"])
+def test_unwritable_render_outputs_fail_before_the_run(tmp_path: Path, target: str, expected: str, option: str,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    target = target.format(tmp=tmp_path)
+    if option == "--frames":
+        target = target.removesuffix(".mp4")
+    assert main(["solve", "--start", "1", "--end", "3", "--blocks", "1", option, target]) == 2
+    err = _one_error_line(capsys.readouterr().err)  # no progress line: nothing was simulated
+    assert err.startswith(f"ur3hanoi: error: cannot write {target}: ") and expected in err
+    assert _listing(tmp_path) == []
+
+
+def test_a_video_named_like_an_ffmpeg_option_is_a_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    import imageio_ffmpeg
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["solve", "--start", "1", "--end", "3", "--blocks", "1", "--video=-x.mp4", "--size", "32x24",
+                 "--fps", "5", "--to", "0.6"]) == 0
+    assert "wrote 4 frames to -x.mp4" in capsys.readouterr().out
+    assert imageio_ffmpeg.count_frames_and_secs(str(tmp_path / "-x.mp4"))[0] == 4
+    assert _listing(tmp_path) == ["-x.mp4"]
+
+
+@requires_ros
+def test_ros_station_report_dash_is_standard_output(tmp_path: Path) -> None:
+    env = ros_env(free_port(), tmp_path)
+    result = run(ur3hanoi_cmd("ros-station", "--duration", "1", "--report", "-"), env, 120.0)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    report = json.loads("\n".join(lines[lines.index("{"):]))  # the JSON report (info lines may precede it)
+    assert report["control"]["cycles"] > 0 and report["reports_written"] == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ros_home"]  # no file named '-'
+
+
+@pytest.mark.parametrize("option", ["--video", "--frames"])
+def test_ctrl_c_during_a_rendered_solve_leaves_the_old_output(option: str, tmp_path: Path,
+                                                              monkeypatch: pytest.MonkeyPatch,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    from ur3hanoi.cli import solve
+
+    real = solve._ProgressLines.__call__
+
+    def interrupt_halfway(self: solve._ProgressLines, fraction: float, label: str) -> None:
+        real(self, fraction, label)
+        if fraction >= 0.5 and getattr(self.recorder, "count", 0) > 0:  # frames rendered: then Ctrl-C
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(solve._ProgressLines, "__call__", interrupt_halfway)
+    out = tmp_path / ("run.mp4" if option == "--video" else "frames")
+    if option == "--video":
+        out.write_bytes(b"the previous video")
+    else:
+        out.mkdir()
+        (out / "frame_00000.png").write_bytes(b"the previous frame")
+    assert main(["solve", "--start", "1", "--end", "3", "--blocks", "1", option, str(out), "--size", "32x24",
+                 "--fps", "5"]) == 130
+    assert "interrupted" in capsys.readouterr().err
+    if option == "--video":
+        assert out.read_bytes() == b"the previous video"
+    else:
+        assert {p.name: p.read_bytes() for p in out.iterdir()} == {"frame_00000.png": b"the previous frame"}
+    assert _listing(tmp_path) == [out.name]

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import errno
+import fcntl
 import multiprocessing
 import os
-import tempfile
+import signal
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -13,7 +16,8 @@ import pytest
 import yaml
 
 from ur3hanoi.errors import OutputError
-from ur3hanoi.io.atomic import atomic_write, check_output, locked_output
+from ur3hanoi.io.atomic import atomic_write, check_output, lock_file_name, locked_output
+from ur3hanoi.io.atomic import files as atomic_files
 from ur3hanoi.io.yaml_loader import parse_yaml
 
 
@@ -91,18 +95,23 @@ def test_refused_outputs_write_nothing(tmp_path: Path, kind: str, match: str) ->
     [
         ("fsync", OSError(errno.ENOSPC, "No space left on device"), "No space left on device; nothing was written"),
         ("replace", OSError(errno.EXDEV, "Invalid cross-device link"), "Invalid cross-device link"),
-        ("mkstemp", OSError(errno.EROFS, "Read-only file system"), "Read-only file system"),
+        ("open", OSError(errno.EROFS, "Read-only file system"), "Read-only file system"),
     ],
 )
+@pytest.mark.parametrize("anonymous", [True, False], ids=["O_TMPFILE", "named"])
 def test_failed_write_leaves_old_file_and_no_temp(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, patch: str,
-                                                  exc: OSError, match: str) -> None:
+                                                  exc: OSError, match: str, anonymous: bool) -> None:
     out = tmp_path / "a.txt"
     out.write_text("old\n")
+    monkeypatch.setattr(atomic_files, "ANONYMOUS_TEMPORARIES", anonymous)
+    real = getattr(os, patch)
 
     def fail(*args: Any, **kwargs: Any) -> Any:
+        if patch == "open" and not args[1] & (os.O_CREAT | os.O_TMPFILE):  # directories still open
+            return real(*args, **kwargs)
         raise exc
 
-    monkeypatch.setattr(tempfile if patch == "mkstemp" else os, patch, fail)
+    monkeypatch.setattr(os, patch, fail)
     with pytest.raises(OutputError, match=match):
         atomic_write(out, "new\n")
     assert out.read_text() == "old\n"
@@ -156,3 +165,161 @@ def test_concurrent_writers_never_lose_a_key(tmp_path: Path) -> None:
     data = parse_yaml(path.read_text(), str(path))
     assert data == {f"writer{i}": list(range(ROUNDS)) for i in range(WRITERS)}
     assert _listing(tmp_path) == ["shared.yaml"]
+
+
+# ------------------------------------------------------------------------------------ names, SIGKILL, symlinks
+
+OTHER_UID = 65534  # nobody: the "other user" who plants links and lock files (tests run as root)
+
+
+def _sticky_dir(tmp_path: Path) -> Path:
+    """A shared sticky world-writable directory like /tmp, owned by root (the caller here)."""
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o1777)
+    return shared
+
+
+@pytest.mark.parametrize("n_bytes", [250, 254, 255])
+def test_file_names_up_to_name_max_are_written(tmp_path: Path, n_bytes: int) -> None:
+    name = "é" * ((n_bytes - 4) // 2) + "x" * ((n_bytes - 4) % 2) + ".txt"  # multi-byte UTF-8 counts in bytes
+    assert len(os.fsencode(name)) == n_bytes
+    out = tmp_path / name
+    atomic_write(out, "one\n")
+    with locked_output(out) as o:
+        o.write(o.path.read_text() + "two\n")
+    assert out.read_text() == "one\ntwo\n"
+    assert _listing(tmp_path) == [name]
+
+
+_KILLED_WRITER = """
+import os, sys
+from ur3hanoi.io import atomic
+from ur3hanoi.io.atomic import files
+files.ANONYMOUS_TEMPORARIES = sys.argv[2] == "anonymous"
+def stall(fd):
+    print("writing", flush=True)  # the text is in the temporary file, not yet renamed: wait to be killed
+    import time
+    time.sleep(60)
+os.fsync = stall
+atomic.atomic_write(sys.argv[1], "new\\n" * 100000)
+"""
+
+
+def _kill_mid_write(out: Path, mode: str) -> None:
+    proc = subprocess.Popen([sys.executable, "-c", _KILLED_WRITER, str(out), mode], stdout=subprocess.PIPE,
+                            text=True)
+    try:
+        assert proc.stdout is not None and proc.stdout.readline() == "writing\n"
+        proc.send_signal(signal.SIGKILL)
+    finally:
+        proc.wait(timeout=30)
+    assert proc.returncode == -signal.SIGKILL
+
+
+def test_sigkill_mid_write_leaves_no_temporary_file(tmp_path: Path) -> None:
+    out = tmp_path / "lab2_data.yaml"
+    out.write_text("old\n")
+    _kill_mid_write(out, "anonymous")  # O_TMPFILE: the text never had a name
+    assert out.read_text() == "old\n"
+    assert _listing(tmp_path) == sorted(["lab2_data.yaml", lock_file_name("lab2_data.yaml")])  # the held lock...
+    atomic_write(tmp_path / "other.txt", "x\n")  # ...is removed by the next write into the directory
+    assert _listing(tmp_path) == ["lab2_data.yaml", "other.txt"]
+
+
+def test_a_later_write_removes_the_named_temporary_of_a_killed_writer(tmp_path: Path) -> None:
+    out = tmp_path / "lab2_data.yaml"
+    out.write_text("old\n")
+    _kill_mid_write(out, "named")  # the fallback where O_TMPFILE is unsupported: a named temporary is left...
+    left = [n for n in _listing(tmp_path) if n not in ("lab2_data.yaml", lock_file_name("lab2_data.yaml"))]
+    assert len(left) == 1 and out.read_text() == "old\n"
+    live = tmp_path / left[0].replace(left[0].split("-")[1], str(os.getpid()), 1)  # one of a running process
+    live.write_text("busy\n")
+    atomic_write(tmp_path / "other.txt", "x\n")  # ...and removed by the next write into the directory
+    assert _listing(tmp_path) == sorted(["lab2_data.yaml", "other.txt", live.name])
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="planting another user's link needs root (os.lchown)")
+@pytest.mark.parametrize("write", ["atomic_write", "locked_output"])
+def test_a_link_planted_by_another_user_in_a_sticky_directory_is_not_followed(tmp_path: Path, write: str) -> None:
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious\n")
+    shared = _sticky_dir(tmp_path)
+    link = shared / "plan.csv"
+    link.symlink_to(victim)
+    os.lchown(link, OTHER_UID, OTHER_UID)
+    with pytest.raises(OutputError, match=r"symbolic link of user .*uid 65534.* sticky directory") as info:
+        if write == "atomic_write":
+            atomic_write(link, "evil\n")
+        else:
+            with locked_output(link) as out:
+                out.write("evil\n")
+    assert "\n" not in str(info.value)
+    assert victim.read_text() == "precious\n" and _listing(shared) == ["plan.csv"]
+    # Also when the planted link is a directory on the way, or check_output alone is asked.
+    (shared / "d").symlink_to(tmp_path)
+    os.lchown(shared / "d", OTHER_UID, OTHER_UID)
+    with pytest.raises(OutputError, match="sticky directory"):
+        check_output(shared / "d" / "victim.txt")
+    assert victim.read_text() == "precious\n"
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="chown needs root")
+def test_links_of_the_caller_or_the_directory_owner_are_followed(tmp_path: Path) -> None:
+    target = tmp_path / "real.txt"
+    shared = _sticky_dir(tmp_path)
+    mine = shared / "mine.txt"
+    mine.symlink_to(target)  # the caller's own link
+    atomic_write(mine, "a\n")
+    assert target.read_text() == "a\n"
+    owned = tmp_path / "owned"  # a sticky directory of the other user, whose own link is trusted
+    owned.mkdir()
+    owned.chmod(0o1777)
+    os.chown(owned, OTHER_UID, OTHER_UID)
+    theirs = owned / "theirs.txt"
+    theirs.symlink_to(target)
+    os.lchown(theirs, OTHER_UID, OTHER_UID)
+    atomic_write(theirs, "b\n")
+    assert target.read_text() == "b\n"
+    plain = tmp_path / "plain"  # not sticky: any link is followed, as the kernel does
+    plain.mkdir()
+    (plain / "l.txt").symlink_to(target)
+    os.lchown(plain / "l.txt", OTHER_UID, OTHER_UID)
+    atomic_write(plain / "l.txt", "c\n")
+    assert target.read_text() == "c\n"
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="chown needs root")
+def test_a_lock_file_of_another_user_is_a_clear_error_not_a_wait(tmp_path: Path) -> None:
+    out = tmp_path / "lab2_data.yaml"
+    out.write_text("old\n")
+    lock = tmp_path / lock_file_name("lab2_data.yaml")
+    lock.write_text("")
+    os.chown(lock, OTHER_UID, OTHER_UID)
+    holder = os.open(lock, os.O_RDWR)
+    fcntl.flock(holder, fcntl.LOCK_EX)  # the other user's writer holds it
+    try:
+        with pytest.raises(OutputError, match=r"the lock file .*\.lock belongs to .*uid 65534"):
+            atomic_write(out, "new\n")
+    finally:
+        os.close(holder)
+    assert out.read_text() == "old\n"
+
+
+@pytest.mark.parametrize(("path", "match"), [
+    ("-", "standard output"),
+    ("/proc/x.txt", "does not accept new files"),
+])
+def test_outputs_that_cannot_be_written_are_refused_before_writing(path: str, match: str) -> None:
+    with pytest.raises(OutputError, match=match) as info:
+        check_output(path)
+    assert "\n" not in str(info.value)
+
+
+def test_a_removed_working_directory_is_one_line(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    with pytest.raises(OutputError, match="the current directory is unusable"):
+        check_output("x.txt")

@@ -85,7 +85,7 @@ def test_solves_in_world_time(name, start, end, request):
     assert len(result.moves) == 7
     assert slots(world) == {0: (end, 0), 1: (end, 1), 2: (end, 2)}
     assert world.at_home() and not world.suction_on
-    assert driver.rejected == [] and driver.summary()["max_settle_s"] < 0.1
+    assert not driver.rejected and driver.summary()["max_settle_s"] < 0.1
     assert [c for c in arm.calls if c.startswith("suction")] == ["suction on", "suction off"] * 7
 
 

@@ -2,12 +2,23 @@
 
 from __future__ import annotations
 
+import os
+import signal
+import stat
 from pathlib import Path
 
 import pytest
+from PIL import Image
 
-from ur3hanoi.errors import SimulationError
-from ur3hanoi.sim import CameraConfig, OffscreenRecorder, ViewerSink, build_task_scene, display_available
+from ur3hanoi.errors import OutputError, SimulationError
+from ur3hanoi.sim import (
+    CameraConfig,
+    OffscreenRecorder,
+    TaskScene,
+    ViewerSink,
+    build_task_scene,
+    display_available,
+)
 
 from .sim_helpers import STATIONS
 
@@ -50,3 +61,134 @@ def test_no_display_is_reported_without_cli_flags(monkeypatch: pytest.MonkeyPatc
 def test_display_variable_makes_a_display_available(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("WAYLAND_DISPLAY", "wayland-0")
     assert display_available() is None
+
+
+# ------------------------------------------------------------------------------------ outputs: atomic and safe
+
+TINY = CameraConfig(width=32, height=24, fps=10.0)
+
+
+def _recorder(**kwargs: object) -> tuple[OffscreenRecorder, TaskScene]:
+    scene = build_task_scene(STATIONS["lab_sim"], 0, 1)
+    try:
+        return OffscreenRecorder(STATIONS["lab_sim"], scene.model, camera=TINY, **kwargs), scene  # type: ignore[arg-type]
+    except SimulationError as exc:
+        pytest.skip(str(exc))
+
+
+def _offer(rec: OffscreenRecorder, scene: TaskScene, n: int) -> None:
+    for i in range(n):
+        scene.data.time = i / TINY.fps
+        rec(scene.model, scene.data)
+
+
+def _ffmpeg_children() -> list[int]:
+    """The pids of this process's ffmpeg children (imageio-ffmpeg's encoder)."""
+    pids = []
+    for task in Path(f"/proc/{os.getpid()}/task").iterdir():
+        for pid in (task / "children").read_text().split():
+            if "ffmpeg" in Path(f"/proc/{pid}/cmdline").read_text(errors="replace"):
+                pids.append(int(pid))
+    return pids
+
+
+def test_an_interrupted_video_leaves_the_existing_file_as_it_was(tmp_path: Path) -> None:
+    video = tmp_path / "run.mp4"
+    video.write_bytes(b"the previous video")
+    rec, scene = _recorder(video=video)
+    with pytest.raises(KeyboardInterrupt), rec:
+        _offer(rec, scene, 3)
+        raise KeyboardInterrupt  # Ctrl-C in the middle of the run
+    assert video.read_bytes() == b"the previous video"
+    assert _listing(tmp_path) == ["run.mp4"]
+
+
+def test_a_failed_encoder_leaves_the_existing_file_as_it_was(tmp_path: Path) -> None:
+    video = tmp_path / "run.mp4"
+    video.write_bytes(b"the previous video")
+    rec, scene = _recorder(video=video)
+    with pytest.raises(SimulationError, match=r"cannot write .*run\.mp4") as info, rec:
+        _offer(rec, scene, 2)
+        for pid in _ffmpeg_children():
+            os.kill(pid, signal.SIGKILL)  # ffmpeg dies mid-video
+        _offer(rec, scene, 30)
+    assert "\n" not in str(info.value)
+    assert video.read_bytes() == b"the previous video"
+    assert _listing(tmp_path) == ["run.mp4"]
+
+
+def test_a_video_named_like_an_option_is_a_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import imageio_ffmpeg
+
+    monkeypatch.chdir(tmp_path)
+    rec, scene = _recorder(video=Path("-x.mp4"))  # as `--video=-x.mp4` gives it
+    with rec:
+        _offer(rec, scene, 3)
+    assert imageio_ffmpeg.count_frames_and_secs(str(tmp_path / "-x.mp4"))[0] == 3
+    assert _listing(tmp_path) == ["-x.mp4"]
+
+
+def test_a_finished_video_replaces_the_old_one_keeping_its_permissions(tmp_path: Path) -> None:
+    import imageio_ffmpeg
+
+    video = tmp_path / "run.webm"
+    video.write_bytes(b"old")
+    video.chmod(0o640)
+    rec, scene = _recorder(video=video)
+    with rec:
+        _offer(rec, scene, 2)
+    assert imageio_ffmpeg.count_frames_and_secs(str(video))[0] == 2
+    assert stat.S_IMODE(video.stat().st_mode) == 0o640 and _listing(tmp_path) == ["run.webm"]
+
+
+def test_interrupted_frames_leave_no_folder_and_an_existing_one_as_it_was(tmp_path: Path) -> None:
+    new = tmp_path / "new"
+    rec, scene = _recorder(frames_dir=new)
+    with pytest.raises(KeyboardInterrupt), rec:
+        _offer(rec, scene, 2)
+        raise KeyboardInterrupt
+    assert _listing(tmp_path) == []
+    old = tmp_path / "old"
+    old.mkdir()
+    for name in ("frame_00000.png", "frame_00001.png", "frame_00002.png", "notes.txt"):
+        (old / name).write_bytes(b"previous run")
+    rec, scene = _recorder(frames_dir=old)
+    with pytest.raises(KeyboardInterrupt), rec:
+        _offer(rec, scene, 2)
+        raise KeyboardInterrupt
+    assert {p.name: p.read_bytes() for p in old.iterdir()} == {
+        name: b"previous run" for name in ("frame_00000.png", "frame_00001.png", "frame_00002.png", "notes.txt")}
+
+
+def test_finished_frames_replace_an_earlier_runs_frames_only(tmp_path: Path) -> None:
+    old = tmp_path / "frames"
+    old.mkdir()
+    for name in ("frame_00000.png", "frame_00001.png", "frame_00002.png", "notes.txt"):
+        (old / name).write_bytes(b"previous run")
+    rec, scene = _recorder(frames_dir=old)
+    with rec:
+        _offer(rec, scene, 2)
+    assert _listing(old) == ["frame_00000.png", "frame_00001.png", "notes.txt"]
+    assert Image.open(old / "frame_00001.png").size == (32, 24) and (old / "notes.txt").read_bytes() == b"previous run"
+    rec, scene = _recorder(frames_dir=tmp_path / "fresh")  # a new folder is renamed into place
+    with rec:
+        _offer(rec, scene, 1)
+    assert _listing(tmp_path) == ["frames", "fresh"] and _listing(tmp_path / "fresh") == ["frame_00000.png"]
+
+
+@pytest.mark.parametrize(("kind", "match"), [
+    ("proc", "does not accept new files"),
+    ("missing", "does not exist"),
+])
+def test_unwritable_outputs_are_refused_before_rendering(tmp_path: Path, kind: str, match: str) -> None:
+    scene = build_task_scene(STATIONS["lab_sim"], 0, 1)
+    target = Path("/proc/x.mp4") if kind == "proc" else tmp_path / "no" / "x.mp4"
+    with pytest.raises(OutputError, match=match):
+        OffscreenRecorder(STATIONS["lab_sim"], scene.model, camera=TINY, video=target)
+    with pytest.raises(OutputError, match=match):
+        OffscreenRecorder(STATIONS["lab_sim"], scene.model, camera=TINY, frames_dir=target.with_suffix(""))
+    assert _listing(tmp_path) == []
+
+
+def _listing(directory: Path) -> list[str]:
+    return sorted(p.name for p in directory.iterdir())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +22,19 @@ def calibration_ref(arg: str | None) -> str:
 def input_file(ref: str) -> Path:
     """The file behind a calibration argument (a shipped station name or a path)."""
     return station_file(ref)
+
+
+def check_render_outputs(video: str | None, frames: str | None, inputs: Sequence[Path] = ()) -> None:
+    """Refuse a ``--video`` file or ``--frames`` folder that cannot be written, before any work (the rules of
+    :mod:`ur3hanoi.io.atomic`). Imports MuJoCo (set ``MUJOCO_GL`` first)."""
+    from ur3hanoi.io.atomic import check_output, check_output_dir
+    from ur3hanoi.sim.render import check_video_path
+
+    if video:
+        check_output(video, inputs=inputs)  # first: "it is a directory" says more than "no extension"
+        check_video_path(video)
+    if frames:
+        check_output_dir(frames, inputs=inputs)
 
 
 def shown(path: Any) -> str:

@@ -87,13 +87,20 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
 def _run_station(args: argparse.Namespace) -> int:
     if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
         os.environ["MUJOCO_GL"] = "egl"  # headless offscreen rendering (read when the GL context is created)
+    from ur3hanoi.cli.common import check_render_outputs, input_file
+    from ur3hanoi.io.atomic import check_output
     from ur3hanoi.ros.station import RosStation, StationOptions
 
+    inputs = [input_file(args.calibration or DEFAULT_CALIBRATION)]
+    report_file = None if args.report in (None, "-") else Path(args.report)  # "-": standard output
+    if report_file is not None:
+        check_output(report_file, inputs=inputs)  # before any work
+    check_render_outputs(args.video, args.frames, inputs)
     options = StationOptions(
         calibration=args.calibration or DEFAULT_CALIBRATION, start=args.start - 1, n_blocks=args.blocks,
         removed=None if args.remove_block is None else args.remove_block - 1,
         drop_on_grasp=None if args.drop_on_grasp is None else args.drop_on_grasp - 1, seed=args.seed,
-        rate_hz=args.rate, report=Path(args.report) if args.report else None,
+        rate_hz=args.rate, report=report_file,
         frames=Path(args.frames) if args.frames else None, video=Path(args.video) if args.video else None,
         duration_s=args.duration, master_uri=args.master, host=args.host)
     node = RosStation(options)
@@ -110,7 +117,7 @@ def _run_station(args: argparse.Namespace) -> int:
         sys.stdout.flush()
         os.dup2(report_fd, 1)
         os.close(report_fd)
-    if args.report:
+    if report_file is not None:
         c, ctl = report["commands"], report["control"]
         blocks = ", ".join(f"{b['block']} " + ("off-grid" if b["tower"] is None else
                                               f"tower {b['tower']} height {b['height']}")

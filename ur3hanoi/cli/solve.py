@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ur3hanoi.cli import exit_codes
-from ur3hanoi.cli.common import DEFAULT_CALIBRATION, calibration_ref, input_file, shown
+from ur3hanoi.cli.common import DEFAULT_CALIBRATION, calibration_ref, check_render_outputs, input_file, shown
 from ur3hanoi.cli.options import (
     BLOCKS,
     FPS,
@@ -38,7 +38,7 @@ from ur3hanoi.cli.options import (
     image_size,
     option,
 )
-from ur3hanoi.errors import OutputError, SuctionFaultError, Ur3HanoiError, printable
+from ur3hanoi.errors import SuctionFaultError, Ur3HanoiError
 from ur3hanoi.labfile import TABLE_KEYS
 
 if TYPE_CHECKING:
@@ -167,20 +167,7 @@ def _check_render_options(args: argparse.Namespace) -> None:
 
 def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
     """Refuse a video or frames path that cannot be written, before simulating anything."""
-    from ur3hanoi.io.atomic import check_output
-    from ur3hanoi.sim.render import check_video_path
-
-    if args.video:
-        check_output(args.video, inputs=inputs)  # first: "it is a directory" says more than "no extension"
-        check_video_path(args.video)
-    if args.frames:
-        try:
-            Path(args.frames).mkdir(parents=True, exist_ok=True)
-        except (OSError, ValueError) as exc:
-            problem = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-            raise OutputError(f"cannot write frames into {printable(args.frames)}: {problem}") from None
-        if not os.access(args.frames, os.W_OK | os.X_OK):
-            raise OutputError(f"cannot write frames into {printable(args.frames)}: the directory is not writable")
+    check_render_outputs(args.video, args.frames, inputs)
 
 
 def _towers(args: argparse.Namespace, n_towers: int) -> tuple[int, int]:
@@ -293,6 +280,10 @@ def run(args: argparse.Namespace) -> int:
             if exc.result is None:
                 raise
             result, fault = exc.result, exc
+    except BaseException:
+        if isinstance(sink, OffscreenRecorder):
+            sink.discard()  # an interrupted or failed run leaves an existing video or folder as it was
+        raise
     finally:
         if sink is not None:
             sink.close()  # type: ignore[attr-defined]

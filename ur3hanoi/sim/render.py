@@ -6,13 +6,20 @@ extension (:data:`VIDEO_FORMATS`: ``.mp4``, ``.mkv``, ``.mov`` with H.264, ``.we
 :func:`check_video_path` refuses any other extension before anything is simulated. The recorder renders only
 inside its time window (``t_from``..``t_to`` [s] of sim time) and sizes MuJoCo's offscreen framebuffer to the image.
 
+Outputs go through :mod:`ur3hanoi.io.atomic`: ffmpeg writes a temporary file beside the video (same extension, an
+absolute path, so a name like ``-x.mp4`` is never an ffmpeg option) that replaces the video only when the recorder
+is closed normally; frames go to a temporary folder moved into place on close. An error, or leaving the ``with``
+block by an exception, discards them: an existing video or folder stays as it was.
+
 Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo is imported.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,7 +27,8 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from ur3hanoi.errors import OutputError, SimulationError, printable, quote
+from ur3hanoi.errors import OutputError, SimulationError, Ur3HanoiError, printable, quote
+from ur3hanoi.io.atomic import PendingDir, PendingFile, check_output, check_output_dir
 from ur3hanoi.sim.scene import slot_centers
 from ur3hanoi.station import Station
 
@@ -47,6 +55,9 @@ VIDEO_FORMATS: dict[str, VideoFormat] = {
 }
 """The video file extensions :class:`OffscreenRecorder` writes (lower case), and their encoding."""
 
+FRAME_NAME = re.compile(r"frame_\d{5,}\.png")
+"""The names of PNG frames (``frame_00000.png``...): those of an earlier run in the folder are replaced."""
+
 
 def check_video_path(video: str | Path) -> VideoFormat:
     """The encoding of ``video`` by its extension (case-insensitive).
@@ -61,6 +72,12 @@ def check_video_path(video: str | Path) -> VideoFormat:
         raise OutputError(f"cannot write the video {printable(video)}: {got} is not a video format ur3hanoi writes: "
                           f"expected one of {', '.join(VIDEO_FORMATS)}")
     return fmt
+
+
+def _first_line(exc: BaseException) -> str:
+    """An encoder error in one line (imageio-ffmpeg appends the ffmpeg command and its output)."""
+    lines = str(exc).strip().splitlines()
+    return lines[0] if lines else type(exc).__name__
 
 
 @dataclass(frozen=True)
@@ -96,7 +113,8 @@ class OffscreenRecorder:
     Only frames whose sim time lies in ``[t_from, t_to]`` [s] are rendered (``t_to`` None: to the end); ``count``
     is the number written. Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo is imported.
     A video needs ``imageio-ffmpeg`` (its wheel ships ffmpeg) and an extension of :data:`VIDEO_FORMATS`; PNG needs
-    only Pillow. Use as a context manager (it closes the renderer and finishes the file).
+    only Pillow. Use as a context manager (it closes the renderer and finishes the file, or :meth:`discard` s it
+    when the block raises). The output is checked here (:mod:`ur3hanoi.io.atomic`) and written only on close.
     """
 
     def __init__(self, station: Station, model: mujoco.MjModel, frames_dir: Path | None = None,
@@ -118,6 +136,7 @@ class OffscreenRecorder:
         self.count = 0
         self._writer: Any = None
         self._video_format: VideoFormat | None = None
+        self._pending: PendingFile | PendingDir | None = None
         if video is not None:
             fmt = check_video_path(video)
             if fmt.pix_fmt == "yuv420p" and (cam.width % 2 or cam.height % 2):
@@ -133,10 +152,10 @@ class OffscreenRecorder:
             except RuntimeError as exc:  # no ffmpeg binary found
                 raise SimulationError(f"cannot write the video {printable(video)}: {exc}") from None
             self._video_format = fmt
-            video.parent.mkdir(parents=True, exist_ok=True)
+            self._video_out = check_output(video)
         else:
             assert frames_dir is not None
-            frames_dir.mkdir(parents=True, exist_ok=True)
+            self._frames_out = check_output_dir(frames_dir)
         # MuJoCo's offscreen framebuffer is the model's (640x480 unless the XML says otherwise): make it fit.
         vis = model.vis.global_
         vis.offwidth, vis.offheight = max(vis.offwidth, cam.width), max(vis.offheight, cam.height)
@@ -155,13 +174,14 @@ class OffscreenRecorder:
 
         fmt, cam = self._video_format, self.cam_cfg
         assert fmt is not None and self.video is not None
+        self._pending = pending = self._video_out.pending(self.video.suffix.lower())
         try:
-            writer = imageio_ffmpeg.write_frames(
-                str(self.video), (cam.width, cam.height), fps=self.fps, codec=fmt.codec, pix_fmt_out=fmt.pix_fmt,
+            writer = imageio_ffmpeg.write_frames(  # an absolute path: never read as an ffmpeg option
+                str(pending.path), (cam.width, cam.height), fps=self.fps, codec=fmt.codec, pix_fmt_out=fmt.pix_fmt,
                 quality=fmt.quality, macro_block_size=1, ffmpeg_log_level="error", output_params=list(fmt.params))
             writer.send(None)  # starts ffmpeg
         except Exception as exc:  # a failing ffmpeg raises several types
-            raise SimulationError(f"cannot write {printable(self.video)}: {exc}") from None
+            raise SimulationError(f"cannot write {printable(self.video)}: {_first_line(exc)}") from None
         return writer
 
     def __call__(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
@@ -170,6 +190,17 @@ class OffscreenRecorder:
             return
         self.renderer.update_scene(data, self.camera)
         pixels = self.renderer.render()
+        try:
+            self._write(pixels)
+        except BaseException as exc:
+            self.discard()
+            if isinstance(exc, Ur3HanoiError) or not isinstance(exc, Exception):
+                raise
+            where = printable(self.video or self.frames_dir)
+            raise SimulationError(f"cannot write {where}: {_first_line(exc)}") from None
+        self.count += 1
+
+    def _write(self, pixels: Any) -> None:
         if self.video is not None:
             if self._writer is None:
                 self._writer = self._open_writer()
@@ -177,23 +208,48 @@ class OffscreenRecorder:
         else:
             from PIL import Image
 
-            assert self.frames_dir is not None
-            Image.fromarray(pixels).save(self.frames_dir / f"frame_{self.count:05d}.png")
-        self.count += 1
+            if self._pending is None:
+                self._pending = self._frames_out.pending()
+            Image.fromarray(pixels).save(self._pending.path / f"frame_{self.count:05d}.png")
 
-    def _close_writer(self) -> None:
-        if self._writer is not None:
-            writer, self._writer = self._writer, None
-            writer.close()
+    def _finish(self) -> None:
+        """Finish the video (ffmpeg) and put the video or the frames in place."""
+        pending, self._pending = self._pending, None
+        writer, self._writer = self._writer, None
+        try:
+            if writer is not None:
+                writer.close()
+        except Exception as exc:
+            if pending is not None:
+                pending.discard()
+            raise SimulationError(f"cannot write {printable(self.video)}: {_first_line(exc)}") from None
+        if isinstance(pending, PendingDir):
+            pending.commit(replaces=FRAME_NAME)
+        elif pending is not None:
+            pending.commit()
+
+    def discard(self) -> None:
+        """Drop what was rendered: an existing video or frames folder stays as it was."""
+        pending, self._pending = self._pending, None
+        writer, self._writer = self._writer, None
+        if writer is not None:
+            with contextlib.suppress(Exception):
+                writer.close()
+        if pending is not None:
+            pending.discard()
 
     def close(self) -> None:
-        self.renderer.close()
-        self._close_writer()
+        try:
+            self.renderer.close()
+        finally:
+            self._finish()
 
     def __enter__(self) -> OffscreenRecorder:
         return self
 
-    def __exit__(self, *exc: object) -> None:
+    def __exit__(self, exc_type: object, *exc: object) -> None:
+        if exc_type is not None:
+            self.discard()
         self.close()
 
 
