@@ -47,9 +47,11 @@ CONTRACT (shared with ur3hanoi.sim; keep these names and meanings):
   honest baseline), ``config``.
 
 Limits: velocity from the UR3 datasheet (``JointLimits.ur3().v_max``: pi rad/s joints 1-3, 2pi rad/s joints 4-6);
-acceleration 4/8 rad/s^2 and jerk 20/40 rad/s^3 (joints 1-3 / 4-6) are ``JointLimits`` defaults (UR does not
-publish them). ``PlanConfig.speed`` scales all three; each can be overridden. Every sample is checked against
-them, every sample of a vertical phase against the vertical line (``PlanConfig.vertical_tol_m``, 2 mm; every leg
+acceleration 4/8 rad/s^2 and jerk 500/1000 rad/s^3 (joints 1-3 / 4-6, ``ur3hanoi.robot.DEFAULT_JERK_MAX``: the
+``JointLimits`` defaults; UR does not publish them). ``PlanConfig.speed`` scales all three; each can be
+overridden. Every sample is checked against them, against what the suction holds while carrying
+(:func:`~ur3hanoi.plan.checks.check_suction_hold`, ``PlanConfig.suction_hold_mps2``), every sample of a
+vertical phase against the vertical line (``PlanConfig.vertical_tol_m``, 2 mm; every leg
 also by forward kinematics at 1 kHz where it is built), and the clearances by the planner's segment check
 (:mod:`ur3hanoi.plan.clearance`; :func:`check_collisions` checks any sampled trajectory by the same rules).
 

@@ -1,6 +1,7 @@
-"""Safety checks of a sampled plan: joint limits (position, velocity, acceleration, jerk) and the vertical line.
+"""Safety checks of a sampled plan: joint limits (position, velocity, acceleration, jerk), the vertical line, and
+what the suction can hold while carrying.
 
-Both return human-readable violations (empty: the check passed); :func:`ur3hanoi.plan.plan_moves` collects them.
+All return human-readable violations (empty: the check passed); :func:`ur3hanoi.plan.plan_moves` collects them.
 """
 
 from __future__ import annotations
@@ -116,3 +117,39 @@ def check_vertical(tr: Trajectory, moves: Sequence[Move], station: Station, tol_
                    f"{tr.move_index[k] + 1}); allowed {tol_m * 1e3:.1f} mm")
     return out, float(np.max(dev))
 
+
+
+GRAVITY_WORLD = np.array([0.0, 0.0, -9.81])  # [m/s^2]
+
+
+def tcp_accelerations_world(station: Station, q: FloatArray, qd: FloatArray, qdd: FloatArray,
+                            h: float = 1e-3) -> FloatArray:
+    """World acceleration [m/s^2] of the suction point at every row of ``q``/``qd``/``qdd`` (N, 6): the second
+    difference of the forward kinematics along each sample's own second-order Taylor path ``q + s qd + s^2/2 qdd``
+    (s = +-h [s]), exact to O(h^2); no finite difference across samples."""
+    q, qd, qdd = (np.asarray(x, dtype=float).reshape(-1, 6) for x in (q, qd, qdd))
+    half = 0.5 * h * h * qdd
+    plus = tcp_positions_world(station, q + h * qd + half)
+    minus = tcp_positions_world(station, q - h * qd + half)
+    return (plus - 2.0 * tcp_positions_world(station, q) + minus) / (h * h)
+
+
+def check_suction_hold(tr: Trajectory, station: Station, hold_mps2: float) -> tuple[list[str], float]:
+    """While a block is carried (LIFT, CARRY, DESCEND_PLACE), the seal must supply the block's weight and inertia:
+    ``|a - g|`` of the suction point [m/s^2] (per kg of block) must stay within ``hold_mps2``.
+
+    Returns (violations, worst ``|a - g|`` [m/s^2] over the carrying samples).
+    """
+    carrying = np.flatnonzero(np.isin(tr.phase, [int(p) for p in Phase if p.carrying]))
+    if carrying.size == 0:
+        return [], 0.0
+    acc = tcp_accelerations_world(station, tr.q[carrying], tr.qd[carrying], tr.qdd[carrying])
+    pull = np.linalg.norm(acc - GRAVITY_WORLD, axis=1)
+    out: list[str] = []
+    for i in np.flatnonzero(pull > hold_mps2)[:1]:
+        k = carrying[i]
+        n_bad = int(np.count_nonzero(pull > hold_mps2))
+        out.append(f"the carried block needs {pull[i]:.1f} m/s^2 of suction (|a - g| of the suction point) at t = "
+                   f"{tr.t[k]:.3f} s ({Phase(int(tr.phase[k])).name}, move {tr.move_index[k] + 1}; {n_bad} samples); "
+                   f"the suction holds {hold_mps2:.1f} m/s^2: lower the speed or acceleration")
+    return out, float(np.max(pull))

@@ -41,7 +41,7 @@ from ur3hanoi.station import Station
 Slot = tuple[int, int]  # (tower, height), 0-based
 
 # Start of the via search, in the grid's units (vb, vb / T0): near the optimum of the lab stations' connections.
-SEARCH_START = (2.25, 2.0)
+SEARCH_START = (2.0, 1.0)
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ from ur3hanoi.errors import PlanError
 from ur3hanoi.hanoi import Move, check_sequence, solve_hanoi
 from ur3hanoi.plan.baseline import exact_vertical_motion_s, stop_and_go_motion_s
 from ur3hanoi.plan.builder import SegmentBuilder, plan_hops
-from ur3hanoi.plan.checks import check_limits, check_vertical
+from ur3hanoi.plan.checks import check_limits, check_suction_hold, check_vertical
 from ur3hanoi.plan.clearance import check_segments
 from ur3hanoi.plan.sampling import sample
 from ur3hanoi.plan.types import Plan, PlanConfig
@@ -52,6 +52,7 @@ def plan_moves(station: Station, moves: Sequence[Move], config: PlanConfig | Non
     violations = check_limits(tr, segments, limits, station.limits.q_min, station.limits.q_max)
     vert, _ = check_vertical(tr, moves, station, config.vertical_tol_m)
     violations += vert
+    violations += check_suction_hold(tr, station, config.suction_hold_mps2)[0]
     timings["checks"] = time.perf_counter() - t0
     if config.check_collisions and moves:
         t0 = time.perf_counter()

@@ -30,6 +30,12 @@ if TYPE_CHECKING:
 DEFAULT_VIA_SPEEDS: tuple[float, ...] = (0.0, 0.5, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5, 3.0)
 DEFAULT_VIA_ACCELS: tuple[float, ...] = (-2.0, 0.0, 1.0, 2.0, 3.0, 4.0, 6.0)
 
+# [m/s^2] What the suction holds while carrying, as |a - g| of the suction point: a quarter of what the simulated
+# seal holds. bench/bench_suction_hold.py measures, over every carrying control cycle of the lab solves in MuJoCo,
+# at most 0.0125 mm of suction-weld stretch per m/s^2 of |a - g|; the seal counts as broken at 10 mm of stretch
+# (ur3hanoi.sim.SuctionConfig.hold_tolerance), i.e. at 800 m/s^2. The lab plans need at most about 12 m/s^2.
+SUCTION_HOLD_MPS2 = 200.0
+
 
 class Phase(IntEnum):
     """What the robot is doing at a trajectory sample."""
@@ -114,6 +120,8 @@ class PlanConfig:
         collision_rate_hz: coarse rate [Hz] of the clearance check; refined down to 1 ms where the margin is not
             provably enough (see :mod:`ur3hanoi.plan.clearance`).
         raise_on_violation: raise PlanError on the first violation list (False: return it in Plan.violations).
+        suction_hold_mps2: the most the suction holds while carrying, as ``|a - g|`` of the suction point
+            [m/s^2] (weight plus inertia per kg of block). Default :data:`SUCTION_HOLD_MPS2`, see there.
     """
 
     speed: float = 1.0
@@ -131,6 +139,7 @@ class PlanConfig:
     check_collisions: bool = True
     collision_rate_hz: float = 25.0
     raise_on_violation: bool = True
+    suction_hold_mps2: float = SUCTION_HOLD_MPS2
 
     def validate(self) -> None:
         """Raise PlanError naming the first invalid setting."""
@@ -151,7 +160,7 @@ class PlanConfig:
                     or any(b <= a for a, b in itertools.pairwise(grid))):
                 raise PlanError(f"{name} = {grid!r} is invalid: expected increasing finite values including 0"
                                 + (", none negative" if name == "via_speeds" else ""))
-        for name in ("collision_rate_hz", "vertical_tol_m", "clearance_m"):
+        for name in ("collision_rate_hz", "vertical_tol_m", "clearance_m", "suction_hold_mps2"):
             x = getattr(self, name)
             if not (math.isfinite(x) and x > 0.0):  # NaN compares False everywhere: test finiteness explicitly
                 raise PlanError(f"{name} = {x!r} is invalid: expected a finite number > 0")
