@@ -19,7 +19,7 @@ import numpy as np
 def main() -> int:
     from ur3hanoi.errors import Ur3HanoiError
     from ur3hanoi.plan import plan_solve
-    from ur3hanoi.plan.checks import check_suction_hold
+    from ur3hanoi.plan.checks.suction import check_suction_hold
     from ur3hanoi.sim import run_plan
     from ur3hanoi.sim.scene import slot_centers
     from ur3hanoi.station import load_station

@@ -42,7 +42,7 @@ def one(n: int) -> None:
     """Child process: set-up, cold and warm planning of N blocks on the tall grid; prints one JSON line."""
     t0 = time.perf_counter()
     from ur3hanoi.plan import plan_solve
-    from ur3hanoi.plan.clearance import clearance_cache
+    from ur3hanoi.plan.checks.clearance import clearance_cache
     from ur3hanoi.plan.types import PlanConfig
     from ur3hanoi.plan.waypoints import build_waypoints, geometry_key
 
@@ -105,7 +105,7 @@ def bound_motion_s(plan) -> float:  # type: ignore[no-untyped-def]
     """A v+a lower bound of the plan's own segmentation: each Ruckig segment re-timed between the same boundary
     states (position, velocity, acceleration) at the same speed and acceleration limits and jerk x1e4 (in effect
     infinite jerk, like the controller's movej). Exact-vertical 1-DoF legs count as joint-space rest-to-rest."""
-    from ur3hanoi.plan.ruckig import OfflineRuckig
+    from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 
     lim = plan.limits
     rk = OfflineRuckig(lim.v_max, lim.a_max, lim.j_max * 1e4)

@@ -23,7 +23,7 @@ def measure(name: str, scale: float) -> tuple[float, float, float, str, float]:
     """(worst stretch [m], worst |a - g| of the suction point while carrying [m/s^2], motion [s], status, stretch
     per |a - g| [m per m/s^2], least squares over the carrying cycles)."""
     from ur3hanoi.plan import Phase, PlanConfig, plan_solve
-    from ur3hanoi.plan.checks import tcp_positions_world
+    from ur3hanoi.plan.kinematics import tcp_positions_world
     from ur3hanoi.sim import executor
     from ur3hanoi.sim.suction import SuctionCup
     from ur3hanoi.station import load_station

@@ -19,7 +19,7 @@ from ur3hanoi.cli import main
 from ur3hanoi.errors import PlanError, PuzzleError
 from ur3hanoi.grid import ABOVE, ON
 from ur3hanoi.plan import Phase, Plan, PlanConfig, build_waypoints, check_collisions, check_vertical, plan_solve
-from ur3hanoi.plan.legs import DENSE_MARGIN_M
+from ur3hanoi.plan.motion.legs import DENSE_MARGIN_M
 from ur3hanoi.resources import stations_dir
 from ur3hanoi.ros.movej import plan_movej
 from ur3hanoi.station import Station, load_station
@@ -134,7 +134,7 @@ def test_tall_grid_plans_every_n(stations: dict[str, Station]) -> None:
     clearances included: the carried block rises over taller towers (it hit block_6 from 8 blocks up before).
     Faster than the stop-and-go between the same waypoints from 2 blocks on; the single move of 1 block may take up
     to 5 % longer: its slots next to the base need the many-point legs that keep the vertical line without dipping
-    into the stack (see ur3hanoi.plan.legs.CONTACT_OVERSHOOT_M), which the stop-and-go ignores."""
+    into the stack (see ur3hanoi.plan.motion.legs.CONTACT_OVERSHOOT_M), which the stop-and-go ignores."""
     real = stations["lab_real"]
     tall = dataclasses.replace(real, n_heights=10, tower_origins=tuple((0.22, y, z) for _, y, z in real.tower_origins))
     for n in range(1, 11):

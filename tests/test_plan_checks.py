@@ -1,4 +1,4 @@
-"""Safety checks (ur3hanoi.plan.checks): clean plans pass, crafted limit and vertical-line violations are flagged."""
+"""Safety checks (plan.checks.limits): clean plans pass, crafted limit and vertical-line violations are flagged."""
 
 from __future__ import annotations
 
@@ -9,7 +9,8 @@ import pytest
 
 from ur3hanoi.errors import PlanError
 from ur3hanoi.plan import Phase, Plan, PlanConfig, check_limits, check_vertical, plan_solve, tcp_positions_world
-from ur3hanoi.plan.checks import check_suction_hold, tcp_accelerations_world
+from ur3hanoi.plan.checks.suction import check_suction_hold
+from ur3hanoi.plan.kinematics import tcp_accelerations_world
 from ur3hanoi.plan.types import SUCTION_HOLD_MPS2
 from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import Station

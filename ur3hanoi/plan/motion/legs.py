@@ -3,7 +3,7 @@
 A leg joins a slot's "above" pose, where the robot passes at a via state, and its contact ("on") pose, at rest.
 The via state at the above pose moves the suction point along the vertical line: speed ``sigma`` [m/s] and path
 acceleration ``accel`` [m/s^2] (joint velocity ``sigma q'(0)``, acceleration ``sigma^2 q''(0) + accel q'(0)``,
-``q(s)`` the slot's :class:`~ur3hanoi.plan.vertical.VerticalPath`). The candidates form a grid per slot
+``q(s)`` the slot's :class:`~ur3hanoi.plan.motion.vertical.VerticalPath`). The candidates form a grid per slot
 (:class:`SlotLegs`), in units of the slot's own rest-to-rest leg: ``vb = L / T0`` and ``vb / T0``, with ``L`` the
 approach length and ``T0`` the joint-space rest-to-rest leg duration, so one grid fits every station and speed.
 
@@ -11,10 +11,11 @@ Method, and why (measured on lab_sim/lab_real, see ``bench/REPORT.md``):
 
 - One joint-space Ruckig segment from above to on leaves the vertical line by 3-10 mm: the straight joint
   interpolation does not follow the curved ``q(s)``. Through ONE interior IK point on the line at 65 % of the
-  approach, with its path speed and acceleration (2 numbers) chosen by :func:`~ur3hanoi.plan.optimize.nelder_mead`,
-  the leg stays within 0.5-1.6 mm of the line and takes the time of the single joint-space segment (within
-  0.1 % on most cells): that segment is a lower bound (any chain through a via point is also a motion between the
-  same two states), so the search stops as soon as it comes within :data:`LOWER_BOUND_RTOL` of it. If one point
+  approach, with its path speed and acceleration (2 numbers) chosen by
+  :func:`~ur3hanoi.plan.motion.minimize.nelder_mead` (SciPy's Nelder-Mead), the leg stays within 0.5-1.6 mm of
+  the line and takes the time of the single joint-space segment (within 0.1 % on most cells): that segment is a
+  lower bound (any chain through a via point is also a motion between the same two states), so the search stops as soon
+  as it comes within :data:`LOWER_BOUND_RTOL` of it. If one point
   is not enough for the corridor, two (at 1/3 and 2/3) are tried.
 - Following the line exactly (a 1-DoF Ruckig of the path coordinate with limits constant over the path, from the
   worst derivatives) is 1.4-1.6x slower per leg: the joint derivatives vary ~10x along the path, so one constant
@@ -49,12 +50,12 @@ from ruckig import Trajectory as RuckigTrajectory
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
 from ur3hanoi.grid import ABOVE, ON, contact_point_world
-from ur3hanoi.plan.checks import tcp_positions_world
-from ur3hanoi.plan.optimize import nelder_mead
-from ur3hanoi.plan.ruckig import OfflineRuckig
-from ur3hanoi.plan.sampling import evaluate
+from ur3hanoi.plan.kinematics import tcp_positions_world
+from ur3hanoi.plan.motion.minimize import nelder_mead
+from ur3hanoi.plan.motion.ruckig import OfflineRuckig
+from ur3hanoi.plan.motion.sampling import evaluate
+from ur3hanoi.plan.motion.vertical import PathLimits, VerticalPath
 from ur3hanoi.plan.types import KinematicLimits
-from ur3hanoi.plan.vertical import PathLimits, VerticalPath
 from ur3hanoi.plan.waypoints import Waypoints
 from ur3hanoi.station import Station
 
