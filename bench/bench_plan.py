@@ -17,9 +17,7 @@ Run: ``.venv/bin/python bench/bench_plan.py``. Reports, in one run:
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import json
-import math
 import statistics
 import subprocess
 import sys
@@ -69,36 +67,12 @@ def one(n: int) -> None:
                       "ratio": plan.motion_s / plan.stop_and_go_motion_s, "violations": len(plan.violations)}))
 
 
-# Lab program model (tests/lab2_exec_starter.py, /work/shared/lab/ros-interface.md): 20 Hz loop; move_arm publishes,
-# sleeps one period, then polls at 20 Hz until at the goal and sleeps once more; gripper() re-sends the current pose
-# (at the goal at once: one period); time.sleep(1.0) after suction on, time.sleep(0.5) after suction off.
-LAB_V = LAB_A = 4.0  # the starter's movej v, a
-LAB_LOOP_S = 0.05  # its loop period [s] (20 Hz)
-LAB_GRASP_SLEEP_S, LAB_RELEASE_SLEEP_S = 1.0, 0.5
-
-
 def lab_program(plan) -> tuple[float, float, int]:  # type: ignore[no-untyped-def]
     """The lab program on the plan's station and moves: (motion [s], cycle [s], number of movej)."""
-    from ur3hanoi.plan.waypoints import build_waypoints
-    from ur3hanoi.ros.movej import plan_movej
+    from ur3hanoi.plan.baseline.lab_program import lab_program_times
 
-    st = plan.station
-    table = build_waypoints(st).table
-    lim = st.limits
-    home = st.q_home_array
-    qs = [home]
-    for m in plan.moves:
-        src, dst = table[m.from_tower, m.from_height], table[m.to_tower, m.to_height]
-        qs += [src[1], src[0], src[1], dst[1], dst[0], dst[1]]
-    qs.append(home)
-    motion = cycle = 0.0
-    for a, b in itertools.pairwise(qs):
-        t = plan_movej(a, b, LAB_V, LAB_A, lim.v_max, lim.a_max).duration
-        motion += t
-        polls = max(1, math.ceil(t / LAB_LOOP_S - 1e-9))  # first poll at or after arrival (poll k at k periods)
-        cycle += (polls + 1) * LAB_LOOP_S
-    per_move = 2 * LAB_LOOP_S + LAB_GRASP_SLEEP_S + LAB_RELEASE_SLEEP_S  # two gripper() calls and the sleeps
-    return motion, cycle + per_move * len(plan.moves), len(qs) - 1
+    t = lab_program_times(plan.station, plan.moves)
+    return t.motion_s, t.cycle_s, t.n_movej
 
 
 def bound_motion_s(plan) -> float:  # type: ignore[no-untyped-def]

@@ -19,9 +19,9 @@ from ur3hanoi.cli import main
 from ur3hanoi.errors import PlanError, PuzzleError
 from ur3hanoi.grid import ABOVE, ON
 from ur3hanoi.plan import Phase, Plan, PlanConfig, build_waypoints, check_collisions, check_vertical, plan_solve
+from ur3hanoi.plan.baseline.lab_program import lab_program_times
 from ur3hanoi.plan.motion.legs import DENSE_MARGIN_M
 from ur3hanoi.resources import stations_dir
-from ur3hanoi.ros.movej import plan_movej
 from ur3hanoi.station import Station, load_station
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -96,19 +96,6 @@ def test_dwell_samples_rest_on_contact(plans: dict[tuple[str, int, int, int], Pl
     assert not np.any(tr.suction[tr.phase == int(Phase.TRANSIT)])
 
 
-def _lab_program_motion_s(plan: Plan) -> float:
-    """Motion time [s] of the lab program on the plan's moves: one movej per waypoint at v = a = 4 (the UR
-    controller's synchronised trapezoid within the datasheet speeds and the 4/8 rad/s^2 caps), home to home."""
-    table = build_waypoints(plan.station).table
-    lim = plan.station.limits
-    qs = [plan.station.q_home_array]
-    for m in plan.moves:
-        src, dst = table[m.from_tower, m.from_height], table[m.to_tower, m.to_height]
-        qs += [src[1], src[0], src[1], dst[1], dst[0], dst[1]]
-    qs.append(plan.station.q_home_array)
-    return sum(plan_movej(a, b, 4.0, 4.0, lim.v_max, lim.a_max).duration for a, b in itertools.pairwise(qs))
-
-
 def test_faster_than_the_lab_program_and_stop_and_go(plans: dict[tuple[str, int, int, int], Plan]) -> None:
     """Every plan beats joint-space stop-and-go between the same waypoints; the 3-block lab solves move at most
     0.80 x as long as the lab program itself (movej per waypoint at v = a = 4), under the same speed and
@@ -117,7 +104,7 @@ def test_faster_than_the_lab_program_and_stop_and_go(plans: dict[tuple[str, int,
         assert plan.motion_s < plan.stop_and_go_motion_s
     for name in STATIONS:
         plan = plans[(name, 0, 2, 3)]
-        assert plan.motion_s <= 0.80 * _lab_program_motion_s(plan)
+        assert plan.motion_s <= 0.80 * lab_program_times(plan.station, plan.moves).motion_s
     # No stop at a pass-through above point: the via velocity into each descend is non-zero.
     descends = [s for s in plans[("lab_sim", 0, 2, 3)].segments if s.phase == Phase.DESCEND_PICK]
     assert all(np.linalg.norm(s.v_start) > 0.1 for s in descends if s.target.startswith("via"))

@@ -24,7 +24,9 @@ Package map (dependencies flow downward only; each module is one concept):
   :mod:`~ur3hanoi.plan.checks.vertical` the 2 mm vertical line; :mod:`~ur3hanoi.plan.checks.suction` what the
   suction holds while carrying; :mod:`~ur3hanoi.plan.checks.collision` the clearance rules and
   :func:`check_collisions`; :mod:`~ur3hanoi.plan.checks.clearance` the planner's per-segment clearance check.
-- ``baseline/``: :mod:`~ur3hanoi.plan.baseline.stop_and_go` the stop-and-go references between the same waypoints.
+- ``baseline/``: :mod:`~ur3hanoi.plan.baseline.lab_program` the lab's own program on the same moves (movej per
+  waypoint, its waits); :mod:`~ur3hanoi.plan.baseline.stop_and_go` the stop-and-go references between the same
+  waypoints.
 - :mod:`~ur3hanoi.plan.export`: :func:`trajectory_csv` and :func:`plan_json_dict` (what ``ur3hanoi plan`` prints).
 - :mod:`~ur3hanoi.plan.planner`: :func:`plan_moves` / :func:`plan_solve`: hops -> connections -> samples ->
   checks -> :class:`Plan`.
