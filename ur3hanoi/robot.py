@@ -59,7 +59,7 @@ CONTROL_PERIOD_S = 0.008
 # acceleration, which at 125 Hz is exactly such a one-cycle ramp: a planner with a lower jerk is slower than the
 # program it replaces for no physical reason (20/40 rad/s^3 made the plan 4 % slower than the lab program). What
 # this costs the carried block is measured by bench/bench_suction_hold.py (bench/REPORT.md): in MuJoCo the suction
-# weld stretches at most 0.64 mm on lab_sim and 0.27 mm on lab_real at 400-2000 rad/s^3, against the 10 mm at
+# weld stretches at most 0.64 mm on lab_sim and 0.27 mm on lab_real at 100-2000 rad/s^3, against the 10 mm at
 # which the seal counts as broken (SuctionConfig.hold_tolerance): a margin above 15.
 DEFAULT_JERK_MAX: tuple[float, ...] = tuple(a / CONTROL_PERIOD_S for a in DEFAULT_ACCEL_MAX)
 
