@@ -2,11 +2,10 @@
 
 Run: ``.venv/bin/python bench/bench_plan.py``. Reports, in one run:
 
-1. 3 blocks, tower 1 -> 3, on lab_sim and lab_real: the honest baseline (joint-space Ruckig from rest to rest
-   between the same waypoints, same limits and dwells), the plan, their ratio (target <= 0.85, goal 0.80), the
-   exact-vertical stop-and-go (approach/retreat on the exact line, constant path limits: the old reference), time
-   per leg type (vertical legs, motion across) for the three, and the worst distance from the vertical line by
-   forward kinematics at 1 kHz.
+1. 3 blocks, tower 1 -> 3, on lab_sim and lab_real, motion and whole-cycle time of: the lab program itself (the
+   baseline: ``tests/lab2_exec_starter.py``, movej per waypoint at v = a = 4 with its polling and sleeps), the plan,
+   the jerk-limited stop-and-go and a v+a lower bound; ratios to the lab program (targets: motion <= 0.80, cycle
+   <= 0.70, goal 0.65), and the worst distance from the vertical line by forward kinematics at 1 kHz.
 2. Cold ``ur3hanoi plan --start 1 --end 3`` (process start to exit, clearance checks included; target < 1 s).
 3. Planning time per move for N = 1..10 blocks on a tall synthetic grid (lab_real with 10 levels, towers pulled in
    so the top levels stay reachable), clearance checks included: each N in a fresh process. "set-up" is the
@@ -18,7 +17,6 @@ Run: ``.venv/bin/python bench/bench_plan.py``. Reports, in one run:
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import json
 import statistics
 import subprocess
@@ -26,9 +24,9 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
-VERTICAL = ("DESCEND_PICK", "LIFT", "DESCEND_PLACE", "RETREAT")
-ACROSS = ("TRANSIT", "CARRY", "HOME")
 
 
 def _tall():  # type: ignore[no-untyped-def]
@@ -42,7 +40,7 @@ def one(n: int) -> None:
     """Child process: set-up, cold and warm planning of N blocks on the tall grid; prints one JSON line."""
     t0 = time.perf_counter()
     from ur3hanoi.plan import plan_solve
-    from ur3hanoi.plan.clearance import clearance_cache
+    from ur3hanoi.plan.checks.clearance import clearance_cache
     from ur3hanoi.plan.types import PlanConfig
     from ur3hanoi.plan.waypoints import build_waypoints, geometry_key
 
@@ -69,53 +67,68 @@ def one(n: int) -> None:
                       "ratio": plan.motion_s / plan.stop_and_go_motion_s, "violations": len(plan.violations)}))
 
 
-def leg_times(plan) -> tuple[float, float]:  # type: ignore[no-untyped-def]
-    """Summed duration [s] of the plan's vertical legs and of its motions across."""
-    vert = sum(s.duration for s in plan.segments if s.trajectory is not None and s.phase.name in VERTICAL)
-    across = sum(s.duration for s in plan.segments if s.trajectory is not None and s.phase.name in ACROSS)
-    return vert, across
+def lab_program(plan) -> tuple[float, float, int]:  # type: ignore[no-untyped-def]
+    """The lab program on the plan's station and moves: (motion [s], cycle [s], number of movej)."""
+    from ur3hanoi.plan.baseline.lab_program import lab_program_times
+
+    t = lab_program_times(plan.station, plan.moves)
+    return t.motion_s, t.cycle_s, t.n_movej
 
 
-def reference_leg_times(plan, exact_vertical: bool) -> tuple[float, float]:  # type: ignore[no-untyped-def]
-    """The same split for the honest (or exact-vertical) stop-and-go of the plan's waypoints."""
-    from ur3hanoi.plan.builder import plan_hops
-    from ur3hanoi.plan.connections import station_planner
+def bound_motion_s(plan) -> float:  # type: ignore[no-untyped-def]
+    """A v+a lower bound of the plan's own segmentation: each Ruckig segment re-timed between the same boundary
+    states (position, velocity, acceleration) at the same speed and acceleration limits and jerk x1e4 (in effect
+    infinite jerk, like the controller's movej). Exact-vertical 1-DoF legs count as joint-space rest-to-rest."""
+    from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 
-    cfg = plan.config
-    planner = station_planner(plan.station, plan.limits, cfg.vertical_tol_m, cfg.via_speeds, cfg.via_accels)
-    vert = across = 0.0
-    for hop in plan_hops(plan.station, plan.moves, plan.n_blocks, plan.start, cfg.clearance_m):
-        qs = [planner.q_above(hop.slot0), planner.q_above(hop.slot1)]
-        across += sum(planner.rest_to_rest(a, b) for a, b in itertools.pairwise(qs))
-        for slot in (hop.slot0, hop.slot1):
-            if slot is not None:
-                vert += (planner.exact_vertical_leg(slot) if exact_vertical
-                         else planner.rest_to_rest(planner.q_above(slot), planner.wp.table[slot[0], slot[1], 0]))
-    return vert, across
+    lim = plan.limits
+    rk = OfflineRuckig(lim.v_max, lim.a_max, lim.j_max * 1e4)
+    total = 0.0
+    for s in plan.segments:
+        if s.trajectory is None:
+            continue
+        if s.path is not None:
+            z = np.zeros(6)
+            sol = rk.solve(s.q_start, z, z, s.q_end, z, z)
+        else:
+            p0, v0, a0 = s.trajectory.at_time(0.0)
+            p1, v1, a1 = s.trajectory.at_time(s.duration)
+            sol = rk.solve(p0, v0, a0, p1, v1, a1)
+        if not sol.ok or sol.trajectory is None:
+            raise RuntimeError(f"bound: Ruckig failed on a segment: {sol.reason}")
+        total += sol.trajectory.duration
+    return total
 
 
 def lab() -> None:
     from ur3hanoi.plan import PlanConfig, plan_solve
     from ur3hanoi.station import load_station
 
-    print("3 blocks, tower 1 -> 3: motion time [s] (dwells excluded); legs = approach/retreat, across = transit/carry/"
-          "home")
-    print(f"{'station':<9} {'honest':>8} {'plan':>8} {'ratio':>6} {'exact-v':>8} | {'legs: honest':>12} {'plan':>6} "
-          f"{'exact-v':>7} | {'across: honest':>14} {'plan':>6} | {'max dev':>8}")
+    print("3 blocks, tower 1 -> 3. motion = time moving; cycle = the whole program (dwells/sleeps, polling included).")
+    print("lab program = tests/lab2_exec_starter.py: movej per waypoint at v = a = 4 (UR synchronised trapezoid,")
+    print("capped at the datasheet speeds and 4/8 rad/s^2), its 20 Hz polling and its 1.0 s + 0.5 s sleeps per move.")
+    print("stop-and-go = jerk-limited Ruckig rest to rest between the same waypoints, the plan's dwells.")
+    print("bound = v+a lower bound of the plan's segments (jerk x1e4), the plan's dwells.")
+    print(f"{'station':<9} {'':>6} {'lab prog':>9} {'plan':>8} {'ratio':>6} {'stop&go':>8} {'ratio':>6} "
+          f"{'bound':>8} {'ratio':>6}")
     for name in ("lab_sim", "lab_real"):
         st = load_station(name)
         plan = plan_solve(st, 0, 2, 3, PlanConfig())
-        v, a = leg_times(plan)
-        hv, ha = reference_leg_times(plan, exact_vertical=False)
-        ev, _ = reference_leg_times(plan, exact_vertical=True)
-        ratio = plan.motion_s / plan.stop_and_go_motion_s
-        print(f"{name:<9} {plan.stop_and_go_motion_s:>8.3f} {plan.motion_s:>8.3f} {ratio:>6.3f} "
-              f"{plan.exact_vertical_stop_and_go_motion_s:>8.3f} | {hv:>12.3f} {v:>6.3f} {ev:>7.3f} | {ha:>14.3f} "
-              f"{a:>6.3f} | {plan.vertical_deviation_m * 1e3:>5.2f} mm")
-        n_legs = sum(1 for s in plan.segments if s.phase.name in VERTICAL and s.target.split("(")[0] in ("on", "above"))
-        print(f"          per leg: honest {hv / n_legs:.3f} s, plan {v / n_legs:.3f} s, exact-vertical "
-              f"{ev / n_legs:.3f} s ({n_legs} legs); ratio {'within' if ratio <= 0.85 else 'OVER'} 0.85 "
-              f"({'goal 0.80 met' if ratio <= 0.80 else 'goal 0.80 not met'}); {len(plan.violations)} violations")
+        lab_m, lab_c, n_movej = lab_program(plan)
+        bound = bound_motion_s(plan)
+        rows = (("motion", lab_m, plan.motion_s, plan.stop_and_go_motion_s, bound),
+                ("cycle", lab_c, plan.duration_s, plan.stop_and_go_duration_s, bound + plan.dwell_total_s))
+        for label, lab_t, p, sg, b in rows:
+            print(f"{name if label == 'motion' else '':<9} {label:>6} {lab_t:>9.2f} {p:>8.2f} {p / lab_t:>6.3f} "
+                  f"{sg:>8.2f} {sg / lab_t:>6.3f} {b:>8.2f} {b / lab_t:>6.3f}")
+        lim = plan.limits
+        assert lim is not None
+        print(f"{'':<9} targets: motion <= 0.80 ({'met' if plan.motion_s <= 0.80 * lab_m else 'NOT met'}), cycle <= "
+              f"0.70 ({'met' if plan.duration_s <= 0.70 * lab_c else 'NOT met'}; goal 0.65 "
+              f"{'met' if plan.duration_s <= 0.65 * lab_c else 'not met'}); {n_movej} movej; plan dwells "
+              f"{plan.dwell_total_s:.1f} s; jerk {lim.j_max[0]:g}/{lim.j_max[3]:g} rad/s^3; worst distance from the "
+              f"vertical line {plan.vertical_deviation_m * 1e3:.2f} mm (1 kHz, limit 2 mm); "
+              f"{len(plan.violations)} violations")
 
 
 def cli() -> None:

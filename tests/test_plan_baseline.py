@@ -1,4 +1,4 @@
-"""The stop-and-go references (ur3hanoi.plan.baseline): the honest baseline is joint-space rest-to-rest between
+"""The stop-and-go references (plan.baseline.stop_and_go): the honest baseline is joint-space rest-to-rest between
 the plan's waypoints; the exact-vertical one is slower; the plan beats both."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Blending at the above points (ur3hanoi.plan.blend): sideways start inside the corridor, shorter motion."""
+"""Blending at the above points (ur3hanoi.plan.motion.blend): sideways start inside the corridor, shorter motion."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import pytest
 
 from ur3hanoi.grid import contact_point_world
 from ur3hanoi.plan import Phase, PlanConfig, build_waypoints, check_vertical, plan_solve, tcp_positions_world
-from ur3hanoi.plan.blend import lateral_direction
-from ur3hanoi.plan.legs import DENSE_MARGIN_M
+from ur3hanoi.plan.motion.blend import lateral_direction
+from ur3hanoi.plan.motion.legs import DENSE_MARGIN_M
 from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import Station
 

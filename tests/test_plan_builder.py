@@ -1,4 +1,4 @@
-"""The segment builder (ur3hanoi.plan.builder): chained segments, the hops, rising over taller towers."""
+"""The segment builder (ur3hanoi.plan.route.builder): chained segments, the hops, rising over taller towers."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import pytest
 from ur3hanoi.grid import block_center_world, contact_point_world
 from ur3hanoi.hanoi import Move, solve_hanoi, stacks_before_moves
 from ur3hanoi.plan import Phase, PlanConfig, Segment
-from ur3hanoi.plan.builder import OVER_MARGIN_M, SegmentBuilder, plan_hops
+from ur3hanoi.plan.route.builder import OVER_MARGIN_M, SegmentBuilder, plan_hops
 from ur3hanoi.station import Station
 
 

@@ -1,4 +1,4 @@
-"""Safety checks (ur3hanoi.plan.checks): clean plans pass, crafted limit and vertical-line violations are flagged."""
+"""Safety checks (plan.checks.limits): clean plans pass, crafted limit and vertical-line violations are flagged."""
 
 from __future__ import annotations
 
@@ -7,7 +7,11 @@ import dataclasses
 import numpy as np
 import pytest
 
+from ur3hanoi.errors import PlanError
 from ur3hanoi.plan import Phase, Plan, PlanConfig, check_limits, check_vertical, plan_solve, tcp_positions_world
+from ur3hanoi.plan.checks.suction import check_suction_hold
+from ur3hanoi.plan.kinematics import tcp_accelerations_world
+from ur3hanoi.plan.types import SUCTION_HOLD_MPS2
 from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import Station
 
@@ -63,10 +67,10 @@ def test_limit_check_flags_a_position_outside_the_joint_range(plan: Plan) -> Non
 @pytest.mark.parametrize("flagged", [True, False])
 def test_vertical_check_flags_a_line_moved_away(plan: Plan, flagged: bool) -> None:
     """Checked against lines moved sideways by d: every vertical sample is d off, +- the plan's own deviation
-    ``own``; d = 2 mm + own + 0.5 mm breaks the 2 mm tolerance, d = 2 mm - own - 0.2 mm does not."""
+    ``own``; d = 2 mm + own + 0.5 mm breaks the 2 mm tolerance, d = (2 mm - own) / 2 does not."""
     st = plan.station
     _, own = check_vertical(plan.trajectory, plan.moves, st, 0.002)
-    d = 0.002 + own + 0.0005 if flagged else 0.002 - own - 0.0002
+    d = 0.002 + own + 0.0005 if flagged else 0.5 * (0.002 - own)
     assert d > 0
     moved = st.with_grid([(x + d * 0.6, y + d * 0.8, z) for x, y, z in st.tower_origins], st.height_step,
                          st.tool_yaw)
@@ -98,3 +102,42 @@ def test_batched_fk_matches_pinocchio(lab_real: Station) -> None:
     q = np.random.default_rng(1).uniform(-3.0, 3.0, (50, 6))
     expected = np.array([(lab_real.T_world_base * robot.fk(qi, "tcp")).translation for qi in q])
     np.testing.assert_allclose(tcp_positions_world(lab_real, q), expected, rtol=0, atol=1e-10)
+
+
+# ------------------------------------------------------------------------------------------ what the suction holds
+
+
+def test_tcp_acceleration_is_centripetal_when_only_the_base_turns(lab_sim: Station) -> None:
+    """Joint 1 turning at a constant rate w: the suction point circles the base's vertical axis, so its world
+    acceleration is w^2 r towards that axis (r: distance from it), nothing vertical."""
+    q = np.array([lab_sim.q_home_array, lab_sim.q_home_array + np.array([0.3, -0.2, 0.4, 0.1, 0.0, 0.5])])
+    w = 2.0
+    qd = np.zeros_like(q)
+    qd[:, 0] = w
+    acc = tcp_accelerations_world(lab_sim, q, qd, np.zeros_like(q))
+    p = tcp_positions_world(lab_sim, q)
+    axis_xy = lab_sim.T_world_base.translation[:2]
+    radial = p[:, :2] - axis_xy
+    np.testing.assert_allclose(acc[:, :2], -w * w * radial, atol=1e-6)
+    np.testing.assert_allclose(acc[:, 2], 0.0, atol=1e-6)
+
+
+def test_suction_hold_check_flags_only_above_the_limit(plan: Plan) -> None:
+    """The lab plan needs the weight plus a little inertia; a limit just below its worst need flags it, naming a
+    carrying phase and the move, a limit just above does not."""
+    viol, worst = check_suction_hold(plan.trajectory, plan.station, SUCTION_HOLD_MPS2)
+    assert viol == [] and 9.81 < worst < 20.0
+    below, _ = check_suction_hold(plan.trajectory, plan.station, worst - 0.01)
+    assert len(below) == 1 and "of suction" in below[0]
+    assert any(p.name in below[0] for p in Phase if p.carrying) and "move " in below[0]
+    assert check_suction_hold(plan.trajectory, plan.station, worst + 0.01)[0] == []
+
+
+def test_a_plan_the_suction_cannot_hold_is_refused(lab_sim: Station) -> None:
+    """100x the acceleration caps: the carried block would need more than the suction holds, so the planner
+    refuses the plan (the joint limits it was given are all kept)."""
+    cfg = PlanConfig(a_max=(400.0,) * 6, j_max=(5e4,) * 6, check_collisions=False)
+    with pytest.raises(PlanError, match=r"the carried block needs \d+\.\d m/s\^2 of suction"):
+        plan_solve(lab_sim, 0, 2, 3, cfg)
+    plan = plan_solve(lab_sim, 0, 2, 3, dataclasses.replace(cfg, raise_on_violation=False))
+    assert plan.violations and all("of suction" in v for v in plan.violations)

@@ -1,4 +1,4 @@
-"""Clearance of a plan's segments (ur3hanoi.plan.clearance): agrees with the sample-based check, sees a block
+"""Clearance of a plan's segments (ur3hanoi.plan.checks.clearance): agrees with the sample-based check, sees a block
 crossed between two coarse samples, reports a clearance it cannot meet."""
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from ur3hanoi.plan import (
     check_collisions,
     plan_solve,
 )
-from ur3hanoi.plan.clearance import check_segments
+from ur3hanoi.plan.checks.clearance import check_segments
 from ur3hanoi.station import Station
 
 

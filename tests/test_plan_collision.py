@@ -1,4 +1,4 @@
-"""Clearance checks (ur3hanoi.plan.collision): clean plans pass, crafted collisions and clearances are reported."""
+"""Clearance checks (plan.checks.collision): clean plans pass, crafted collisions and clearances are reported."""
 
 from __future__ import annotations
 

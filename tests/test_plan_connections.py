@@ -1,4 +1,4 @@
-"""Connections and the per-station cache (ur3hanoi.plan.connections): keyed by content, pure, chained."""
+"""Connections and the per-station cache (ur3hanoi.plan.route.connections): keyed by content, pure, chained."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ur3hanoi.plan import PlanConfig
-from ur3hanoi.plan.connections import StationPlanner, station_planner
+from ur3hanoi.plan.route.connections import StationPlanner, station_planner
 from ur3hanoi.plan.types import DEFAULT_VIA_ACCELS, DEFAULT_VIA_SPEEDS
 from ur3hanoi.station import Station, load_station
 

@@ -10,7 +10,7 @@ import json
 import numpy as np
 import pytest
 
-from ur3hanoi.plan import Phase, Plan, PlanConfig, plan_solve, trajectory_csv
+from ur3hanoi.plan import Phase, Plan, PlanConfig, plan_json_dict, plan_solve, trajectory_csv
 from ur3hanoi.station import Station
 
 
@@ -35,7 +35,7 @@ def test_csv_round_trips_every_sample(plan: Plan) -> None:
 
 
 def test_json_summary(plan: Plan) -> None:
-    d = json.loads(json.dumps(plan.to_json_dict()))
+    d = json.loads(json.dumps(plan_json_dict(plan)))
     assert (d["start_tower"], d["end_tower"], d["blocks"]) == (2, 3, 2)
     assert d["moves"][0] == {"block": 2, "from_tower": 2, "from_height": 2, "to_tower": 1, "to_height": 1}
     assert d["samples"] == len(plan.trajectory.t) and d["rate_hz"] == 125.0
@@ -54,7 +54,7 @@ def test_json_summary(plan: Plan) -> None:
 def test_json_move_times(plan: Plan) -> None:
     """Each move from the end of the previous one to the end of its release dwell, with its waypoints in order;
     the way home is move 0 and ends with the plan."""
-    times = plan.to_json_dict()["move_times"]
+    times = plan_json_dict(plan)["move_times"]
     assert [m["move"] for m in times] == [1, 2, 3, 0]
     assert times[0]["start_s"] == 0.0 and times[-1]["end_s"] == pytest.approx(plan.duration_s)
     for a, b in itertools.pairwise(times):

@@ -1,4 +1,4 @@
-"""The Ruckig wrapper (ur3hanoi.plan.ruckig): results kept, states reached, halt trajectories and their samples."""
+"""The Ruckig wrapper (plan.motion.ruckig): results kept, states reached, halt trajectories and their samples."""
 
 from __future__ import annotations
 

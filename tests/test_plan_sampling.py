@@ -1,4 +1,4 @@
-"""Sampling (ur3hanoi.plan.sampling): the vectorised sampler equals Ruckig's own ``Trajectory.at_time``."""
+"""Sampling (ur3hanoi.plan.motion.sampling): the vectorised sampler equals Ruckig's own ``Trajectory.at_time``."""
 
 from __future__ import annotations
 

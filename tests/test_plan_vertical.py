@@ -1,4 +1,4 @@
-"""Vertical legs (ur3hanoi.plan.vertical): the path follows the line, its derivatives, its limits, braking speed."""
+"""Vertical legs (plan.motion.vertical): the path follows the line, its derivatives, its limits, braking speed."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from ur3hanoi.grid import ABOVE, ON, contact_point_world
 from ur3hanoi.plan import KinematicLimits, PlanConfig, build_waypoints, tcp_positions_world, to_rest
-from ur3hanoi.plan.vertical import PathLimits, braking_speed
+from ur3hanoi.plan.motion.vertical import PathLimits, braking_speed
 from ur3hanoi.station import Station
 
 SLOTS = [(0, 0), (1, 2), (2, 1)]

@@ -1,4 +1,4 @@
-"""The via-cell search (ur3hanoi.plan.via) on synthetic costs: optimum, bounds, infeasibility, purity."""
+"""The via-cell search (ur3hanoi.plan.motion.via) on synthetic costs: optimum, bounds, infeasibility, purity."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import math
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ur3hanoi.plan.via import Cell, Pair, best_cells
+from ur3hanoi.plan.motion.via import Cell, Pair, best_cells
 
 DIMS: Pair = (5, 4, 6, 3)
 

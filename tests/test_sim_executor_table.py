@@ -58,9 +58,11 @@ def test_an_entry_15_mm_off_halts_naming_the_entry_and_the_distance(
     found = MM.search(msg)
     assert found is not None, msg
     assert found.group(2) == f"table entry tower {t + 1} height {h + 1} on (Q[{t}][{h}][{k}])"
-    # The bad entry puts the cup at its IK target: 15 mm (plus the table's own 4.3 mm) from the grasp point.
+    # The bad entry puts the cup at its IK target: 15 mm (plus the table's own 4.3 mm) from the grasp point; the
+    # servo overshoots a stop by up to 0.5 mm at the default jerk (500 rad/s^3: the acceleration reached within one
+    # 8 ms cycle, like the controller's movej), so the closest approach may be that much nearer.
     assert float(found.group(1)) == pytest.approx(1e3 * np.linalg.norm(np.add(offset, COURSE_LIKE_OFFSET_M)),
-                                                  abs=0.2)
+                                                  abs=0.6)
     assert "a grasp needs 10 mm or less" in msg and "\n" not in msg
 
 

@@ -50,6 +50,20 @@ T_BASELINK_BASE = pin.SE3(pin.utils.rotate("z", math.pi), np.zeros(3))
 Q_HOME_LAB: tuple[float, ...] = tuple(math.radians(d) for d in (120.0, -90.0, 90.0, -90.0, -90.0, 0.0))
 
 
+# [rad/s^2] Acceleration caps (joints 1-3, wrists): not published by UR; the lab's values (see JointLimits.a_max).
+DEFAULT_ACCEL_MAX: tuple[float, ...] = (4.0,) * 3 + (8.0,) * 3
+# [s] The CB3 controller's servo cycle (125 Hz).
+CONTROL_PERIOD_S = 0.008
+# [rad/s^3] Jerk limits: each acceleration cap reached within one servo cycle, a_max / 8 ms = 500 rad/s^3 (joints
+# 1-3) and 1000 rad/s^3 (wrists). Source: UR publishes no jerk limit and the controller's movej steps its
+# acceleration, which at 125 Hz is exactly such a one-cycle ramp: a planner with a lower jerk is slower than the
+# program it replaces for no physical reason (20/40 rad/s^3 made the plan 4 % slower than the lab program). What
+# this costs the carried block is measured by bench/bench_suction_hold.py (bench/REPORT.md): in MuJoCo the suction
+# weld stretches at most 0.64 mm on lab_sim and 0.27 mm on lab_real at 100-2000 rad/s^3, against the 10 mm at
+# which the seal counts as broken (SuctionConfig.hold_tolerance): a margin above 15.
+DEFAULT_JERK_MAX: tuple[float, ...] = tuple(a / CONTROL_PERIOD_S for a in DEFAULT_ACCEL_MAX)
+
+
 @dataclass(frozen=True)
 class JointLimits:
     """UR3 joint limits, from the CB3 datasheet unless stated.
@@ -62,7 +76,7 @@ class JointLimits:
         v_max: speed limits [rad/s]; datasheet 180 deg/s for base/shoulder/elbow, 360 deg/s for the wrists.
         a_max: acceleration limits [rad/s^2]. Not published by UR; default 4 rad/s^2 (joints 1-3) and 8 rad/s^2
             (wrists) keeps the UR3's 56/28/12 N m torques with margin at the lab's 0.0225 kg payload.
-        j_max: jerk limits [rad/s^3]. Not published; default 20 rad/s^3 (joints 1-3), 40 rad/s^3 (wrists).
+        j_max: jerk limits [rad/s^3]. Not published by UR: default :data:`DEFAULT_JERK_MAX`, see there.
     """
 
     q_min: tuple[float, ...]
@@ -82,8 +96,8 @@ class JointLimits:
             q_min=tuple(-x for x in q_max),
             q_max=q_max,
             v_max=(math.pi,) * 3 + (two_pi,) * 3,
-            a_max=(4.0,) * 3 + (8.0,) * 3,
-            j_max=(20.0,) * 3 + (40.0,) * 3,
+            a_max=DEFAULT_ACCEL_MAX,
+            j_max=DEFAULT_JERK_MAX,
         )
 
     def within_position(self, q: FloatArray, tol: float = 1e-12) -> bool:

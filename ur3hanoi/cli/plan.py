@@ -38,7 +38,7 @@ def run(args: argparse.Namespace) -> int:
     import json
 
     from ur3hanoi.io.atomic import atomic_write, check_output
-    from ur3hanoi.plan import PlanConfig, plan_solve, trajectory_csv
+    from ur3hanoi.plan import PlanConfig, plan_json_dict, plan_solve, trajectory_csv
     from ur3hanoi.station import load_station
 
     inputs = [input_file(calibration_ref(args.calibration))]
@@ -54,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
     if args.csv:
         atomic_write(args.csv, trajectory_csv(plan.trajectory), inputs=inputs)
     if args.json:
-        print(json.dumps(plan.to_json_dict()))
+        print(json.dumps(plan_json_dict(plan)))
         return 0
     print(f"{shown(station.name)}: {n_blocks} blocks, tower {args.start} -> {args.end}: {len(plan.moves)} moves")
     for i, m in enumerate(plan.moves, start=1):

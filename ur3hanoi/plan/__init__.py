@@ -3,35 +3,31 @@
 Entry points: :func:`plan_solve` (solve the instance, then plan it) and :func:`plan_moves` (plan a given move
 sequence); both return a :class:`Plan`. Everything listed in ``__all__`` is importable from ``ur3hanoi.plan``.
 
-Module map (dependencies flow downward only):
+Package map (dependencies flow downward only; each module is one concept):
 
 - :mod:`~ur3hanoi.plan.types`: the data types: :class:`Phase`, :class:`Trajectory`, :class:`KinematicLimits`,
   :class:`PlanConfig`, :class:`Segment`, :class:`Plan`.
-- :mod:`~ur3hanoi.plan.ruckig`: the one Ruckig wrapper of the project (offline only, keeps Ruckig's ``Result``):
-  :class:`OfflineRuckig`, :class:`RuckigSolution`, :func:`to_rest`, :func:`to_pose`, :func:`control_samples`.
-- :mod:`~ur3hanoi.plan.vertical`: a slot's vertical line as a joint-space path (:class:`VerticalPath`), its
-  limits (:class:`~ur3hanoi.plan.vertical.PathLimits`) and braking speed.
+- :mod:`~ur3hanoi.plan.kinematics`: the suction point's world position and acceleration, vectorised.
+- ``motion/``: how the arm moves.
+  :mod:`~ur3hanoi.plan.motion.ruckig` the one Ruckig wrapper (offline; keeps Ruckig's ``Result``);
+  :mod:`~ur3hanoi.plan.motion.vertical` a slot's vertical line as a joint path (:class:`VerticalPath`);
+  :mod:`~ur3hanoi.plan.motion.sampling` the exact vectorised sampling of the plan at ``rate_hz``;
+  :mod:`~ur3hanoi.plan.motion.minimize` SciPy's Nelder-Mead stopped at a lower bound;
+  :mod:`~ur3hanoi.plan.motion.legs` approach/retreat legs through interior IK points of the line (method there);
+  :mod:`~ur3hanoi.plan.motion.via` the search for a connection's via states at the above poses;
+  :mod:`~ur3hanoi.plan.motion.blend` the motion across starting inside the 2 mm corridor.
 - :mod:`~ur3hanoi.plan.waypoints`: :func:`build_waypoints`: home, the IK table and every slot's vertical path.
-- :mod:`~ur3hanoi.plan.sampling`: :func:`sample`: the exact vectorised re-implementation of Ruckig's
-  ``Trajectory.at_time`` that samples the whole plan at ``rate_hz`` (and :func:`~ur3hanoi.plan.sampling.evaluate`
-  for one trajectory).
-- :mod:`~ur3hanoi.plan.checks`: :func:`check_limits` and :func:`check_vertical` (the 2 mm vertical line).
-- :mod:`~ur3hanoi.plan.optimize`: a small deterministic Nelder-Mead minimiser.
-- :mod:`~ur3hanoi.plan.legs`: approach/retreat legs: joint-space Ruckig through interior IK points of the vertical
-  line, verified by forward kinematics at 1 kHz; the method and why it was chosen are described there.
-- :mod:`~ur3hanoi.plan.via`: the search for a connection's via states at the two above poses.
-- :mod:`~ur3hanoi.plan.blend`: blending at the above poses: the motion across starts inside the 2 mm corridor.
-- :mod:`~ur3hanoi.plan.connections`: :class:`~ur3hanoi.plan.connections.Connection` (exit leg, motion across,
-  entry leg) and the per-station cache :func:`~ur3hanoi.plan.connections.station_planner`.
-- :mod:`~ur3hanoi.plan.builder`: the hops of a move sequence (rising over taller towers) and the chained segments
-  (pass-through or stop-and-go); how the motion is built is described there.
-- :mod:`~ur3hanoi.plan.baseline`: the honest stop-and-go baseline and the exact-vertical stop-and-go reference.
-- :mod:`~ur3hanoi.plan.collision`: :class:`CollisionScene`, the clearance rules and :func:`check_collisions`
-  (clearances of any sampled trajectory).
-- :mod:`~ur3hanoi.plan.clearance`: the clearance check the planner runs, once per distinct segment (continuous
-  time, resolved to 1 ms).
-- :mod:`~ur3hanoi.plan.export`: :func:`trajectory_csv` and the JSON summary behind :meth:`Plan.to_json_dict`
-  (what ``ur3hanoi plan`` prints).
+- ``route/``: from dwell to dwell. :mod:`~ur3hanoi.plan.route.connections` the best connection of two slots and
+  the per-station cache; :mod:`~ur3hanoi.plan.route.builder` the hops of a move sequence (rising over taller towers)
+  and their chained segments.
+- ``checks/``: what a plan must satisfy. :mod:`~ur3hanoi.plan.checks.limits` joint limits;
+  :mod:`~ur3hanoi.plan.checks.vertical` the 2 mm vertical line; :mod:`~ur3hanoi.plan.checks.suction` what the
+  suction holds while carrying; :mod:`~ur3hanoi.plan.checks.collision` the clearance rules and
+  :func:`check_collisions`; :mod:`~ur3hanoi.plan.checks.clearance` the planner's per-segment clearance check.
+- ``baseline/``: :mod:`~ur3hanoi.plan.baseline.lab_program` the lab's own program on the same moves (movej per
+  waypoint, its waits); :mod:`~ur3hanoi.plan.baseline.stop_and_go` the stop-and-go references between the same
+  waypoints.
+- :mod:`~ur3hanoi.plan.export`: :func:`trajectory_csv` and :func:`plan_json_dict` (what ``ur3hanoi plan`` prints).
 - :mod:`~ur3hanoi.plan.planner`: :func:`plan_moves` / :func:`plan_solve`: hops -> connections -> samples ->
   checks -> :class:`Plan`.
 - :mod:`~ur3hanoi.plan.table_plan`: :func:`plan_table`: the same :class:`Plan` through the waypoints of a given
@@ -47,11 +43,13 @@ CONTRACT (shared with ur3hanoi.sim; keep these names and meanings):
   honest baseline), ``config``.
 
 Limits: velocity from the UR3 datasheet (``JointLimits.ur3().v_max``: pi rad/s joints 1-3, 2pi rad/s joints 4-6);
-acceleration 4/8 rad/s^2 and jerk 20/40 rad/s^3 (joints 1-3 / 4-6) are ``JointLimits`` defaults (UR does not
-publish them). ``PlanConfig.speed`` scales all three; each can be overridden. Every sample is checked against
-them, every sample of a vertical phase against the vertical line (``PlanConfig.vertical_tol_m``, 2 mm; every leg
+acceleration 4/8 rad/s^2 and jerk 500/1000 rad/s^3 (joints 1-3 / 4-6, ``ur3hanoi.robot.DEFAULT_JERK_MAX``: the
+``JointLimits`` defaults; UR does not publish them). ``PlanConfig.speed`` scales all three; each can be
+overridden. Every sample is checked against them, against what the suction holds while carrying
+(:func:`~ur3hanoi.plan.checks.suction.check_suction_hold`, ``PlanConfig.suction_hold_mps2``), every sample of a
+vertical phase against the vertical line (``PlanConfig.vertical_tol_m``, 2 mm; every leg
 also by forward kinematics at 1 kHz where it is built), and the clearances by the planner's segment check
-(:mod:`ur3hanoi.plan.clearance`; :func:`check_collisions` checks any sampled trajectory by the same rules).
+(:mod:`ur3hanoi.plan.checks.clearance`; :func:`check_collisions` checks any sampled trajectory by the same rules).
 
 Speed (see ``bench/REPORT.md``): the motion is measured against the honest stop-and-go baseline (joint-space
 Ruckig from rest to rest between the same waypoints, same limits and dwells: ``Plan.stop_and_go_duration_s``);
@@ -59,12 +57,15 @@ the exact-vertical stop-and-go the project used to compare with is ``Plan.exact_
 """
 
 from ur3hanoi.labfile.visits import entries_visited, entry_label, missing_entries
-from ur3hanoi.plan.checks import check_limits, check_vertical, tcp_positions_world
-from ur3hanoi.plan.collision import CollisionScene, check_collisions
-from ur3hanoi.plan.export import trajectory_csv
+from ur3hanoi.plan.checks.collision import CollisionScene, check_collisions
+from ur3hanoi.plan.checks.limits import check_limits
+from ur3hanoi.plan.checks.vertical import check_vertical
+from ur3hanoi.plan.export import plan_json_dict, trajectory_csv
+from ur3hanoi.plan.kinematics import tcp_positions_world
+from ur3hanoi.plan.motion.ruckig import OfflineRuckig, RuckigSolution, control_samples, to_pose, to_rest
+from ur3hanoi.plan.motion.sampling import sample
+from ur3hanoi.plan.motion.vertical import VerticalPath
 from ur3hanoi.plan.planner import plan_moves, plan_solve
-from ur3hanoi.plan.ruckig import OfflineRuckig, RuckigSolution, control_samples, to_pose, to_rest
-from ur3hanoi.plan.sampling import sample
 from ur3hanoi.plan.table_plan import check_table_shape, plan_table
 from ur3hanoi.plan.types import (
     DEFAULT_VIA_ACCELS,
@@ -79,7 +80,6 @@ from ur3hanoi.plan.types import (
     Segment,
     Trajectory,
 )
-from ur3hanoi.plan.vertical import VerticalPath
 from ur3hanoi.plan.waypoints import Waypoints, build_waypoints
 
 __all__ = [
@@ -108,6 +108,7 @@ __all__ = [
     "entries_visited",
     "entry_label",
     "missing_entries",
+    "plan_json_dict",
     "plan_moves",
     "plan_solve",
     "plan_table",

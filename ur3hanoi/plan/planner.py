@@ -1,7 +1,7 @@
 """The planning pipeline: hops -> connections (chained Ruckig segments) -> samples -> safety checks -> :class:`Plan`.
 
 Per station and planning limits, the legs and connections are built once and cached
-(:func:`~ur3hanoi.plan.connections.station_planner`): the first plan on a station pays the set-up (IK table,
+(:func:`~ur3hanoi.plan.route.connections.station_planner`): the first plan on a station pays the set-up (IK table,
 vertical paths, the legs and connections it uses), later plans reuse everything they share with it.
 """
 
@@ -12,11 +12,13 @@ from collections.abc import Sequence
 
 from ur3hanoi.errors import PlanError
 from ur3hanoi.hanoi import Move, check_sequence, solve_hanoi
-from ur3hanoi.plan.baseline import exact_vertical_motion_s, stop_and_go_motion_s
-from ur3hanoi.plan.builder import SegmentBuilder, plan_hops
-from ur3hanoi.plan.checks import check_limits, check_vertical
-from ur3hanoi.plan.clearance import check_segments
-from ur3hanoi.plan.sampling import sample
+from ur3hanoi.plan.baseline.stop_and_go import exact_vertical_motion_s, stop_and_go_motion_s
+from ur3hanoi.plan.checks.clearance import check_segments
+from ur3hanoi.plan.checks.limits import check_limits
+from ur3hanoi.plan.checks.suction import check_suction_hold
+from ur3hanoi.plan.checks.vertical import check_vertical
+from ur3hanoi.plan.motion.sampling import sample
+from ur3hanoi.plan.route.builder import SegmentBuilder, plan_hops
 from ur3hanoi.plan.types import Plan, PlanConfig
 from ur3hanoi.plan.waypoints import build_waypoints
 from ur3hanoi.station import Station
@@ -52,6 +54,7 @@ def plan_moves(station: Station, moves: Sequence[Move], config: PlanConfig | Non
     violations = check_limits(tr, segments, limits, station.limits.q_min, station.limits.q_max)
     vert, _ = check_vertical(tr, moves, station, config.vertical_tol_m)
     violations += vert
+    violations += check_suction_hold(tr, station, config.suction_hold_mps2)[0]
     timings["checks"] = time.perf_counter() - t0
     if config.check_collisions and moves:
         t0 = time.perf_counter()

@@ -9,7 +9,7 @@ import itertools
 import math
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
@@ -22,13 +22,19 @@ from ur3hanoi.robot import N_JOINTS
 from ur3hanoi.station import Station
 
 if TYPE_CHECKING:
-    from ur3hanoi.plan.vertical import VerticalPath
+    from ur3hanoi.plan.motion.vertical import VerticalPath
 
-# The via grid at the above poses (see ur3hanoi.plan.legs): path speeds in units of vb = L / T0 and path
+# The via grid at the above poses (see ur3hanoi.plan.motion.legs): path speeds in units of vb = L / T0 and path
 # accelerations in units of vb / T0 (L: approach length, T0: the slot's joint-space rest-to-rest leg). The lab
 # stations' optima lie at 1.25-2.5 vb and 1-4 vb / T0; 0 must be in both (the rest-to-rest fallback).
 DEFAULT_VIA_SPEEDS: tuple[float, ...] = (0.0, 0.5, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5, 3.0)
 DEFAULT_VIA_ACCELS: tuple[float, ...] = (-2.0, 0.0, 1.0, 2.0, 3.0, 4.0, 6.0)
+
+# [m/s^2] What the suction holds while carrying, as |a - g| of the suction point: a quarter of what the simulated
+# seal holds. bench/bench_suction_hold.py measures, over every carrying control cycle of the lab solves in MuJoCo,
+# at most 0.0126 mm of suction-weld stretch per m/s^2 of |a - g|; the seal counts as broken at 10 mm of stretch
+# (ur3hanoi.sim.SuctionConfig.hold_tolerance), i.e. at about 790 m/s^2. The lab plans need at most about 12.3 m/s^2.
+SUCTION_HOLD_MPS2 = 200.0
 
 
 class Phase(IntEnum):
@@ -105,15 +111,17 @@ class PlanConfig:
         dwell_s: time at rest at each contact pose for the suction to build up / release [s].
         v_max, a_max, j_max: per-joint overrides [rad/s, rad/s^2, rad/s^3] (None: the station's JointLimits).
         pass_through: False plans stop-and-go (zero velocity at every waypoint).
-        blend: start the motion across inside the vertical corridor (see :mod:`ur3hanoi.plan.blend`).
+        blend: start the motion across inside the vertical corridor (see :mod:`ur3hanoi.plan.motion.blend`).
         via_speeds, via_accels: the grid of via states at the above poses, in units of each slot's own rest-to-rest
-            leg (see :mod:`ur3hanoi.plan.legs`); both must contain 0.
+            leg (see :mod:`ur3hanoi.plan.motion.legs`); both must contain 0.
         vertical_tol_m: allowed distance [m] of the suction point from the vertical line in vertical phases.
         clearance_m: required clearance [m] of the carried block from every other block.
         check_collisions: run the Pinocchio/coal clearance checks (slower; limits are always checked).
         collision_rate_hz: coarse rate [Hz] of the clearance check; refined down to 1 ms where the margin is not
-            provably enough (see :mod:`ur3hanoi.plan.clearance`).
+            provably enough (see :mod:`ur3hanoi.plan.checks.clearance`).
         raise_on_violation: raise PlanError on the first violation list (False: return it in Plan.violations).
+        suction_hold_mps2: the most the suction holds while carrying, as ``|a - g|`` of the suction point
+            [m/s^2] (weight plus inertia per kg of block). Default :data:`SUCTION_HOLD_MPS2`, see there.
     """
 
     speed: float = 1.0
@@ -131,6 +139,7 @@ class PlanConfig:
     check_collisions: bool = True
     collision_rate_hz: float = 25.0
     raise_on_violation: bool = True
+    suction_hold_mps2: float = SUCTION_HOLD_MPS2
 
     def validate(self) -> None:
         """Raise PlanError naming the first invalid setting."""
@@ -151,7 +160,7 @@ class PlanConfig:
                     or any(b <= a for a, b in itertools.pairwise(grid))):
                 raise PlanError(f"{name} = {grid!r} is invalid: expected increasing finite values including 0"
                                 + (", none negative" if name == "via_speeds" else ""))
-        for name in ("collision_rate_hz", "vertical_tol_m", "clearance_m"):
+        for name in ("collision_rate_hz", "vertical_tol_m", "clearance_m", "suction_hold_mps2"):
             x = getattr(self, name)
             if not (math.isfinite(x) and x > 0.0):  # NaN compares False everywhere: test finiteness explicitly
                 raise PlanError(f"{name} = {x!r} is invalid: expected a finite number > 0")
@@ -171,10 +180,10 @@ class Segment:
 
     ``trajectory`` is the Ruckig trajectory of the segment (time 0 = ``t_start``), None for a dwell at rest at
     ``q_start``. Usually 6-DoF in joint space; for a vertical leg that follows the line exactly (the rest-to-rest
-    fallback of :mod:`ur3hanoi.plan.legs`) ``path`` is set and ``trajectory`` is the 1-DoF Ruckig trajectory of the
-    path coordinate s [m] (see :class:`ur3hanoi.plan.vertical.VerticalPath`). ``target`` names the waypoint reached
-    at the segment's end (1-based tower/height): ``above``, ``on``, ``over`` (risen over taller towers), ``via``
-    (an interior point of a vertical leg) or ``home``.
+    fallback of :mod:`ur3hanoi.plan.motion.legs`) ``path`` is set and ``trajectory`` is the 1-DoF Ruckig trajectory
+    of the path coordinate s [m] (see :class:`ur3hanoi.plan.motion.vertical.VerticalPath`). ``target`` names the
+    waypoint reached at the segment's end (1-based tower/height): ``above``, ``on``, ``over`` (risen over taller
+    towers), ``via`` (an interior point of a vertical leg) or ``home``.
     """
 
     phase: Phase
@@ -203,7 +212,7 @@ class Plan:
         trajectory: the sampled motion.
         stop_and_go_duration_s: cycle time [s] of the honest baseline: joint-space Ruckig from rest to rest between
             the same waypoints under the same limits, with the same dwells (it ignores the vertical line; see
-            :mod:`ur3hanoi.plan.baseline`).
+            :mod:`ur3hanoi.plan.baseline.stop_and_go`).
         segments: the chained Ruckig segments and dwells.
         limits: the planning limits actually used.
         violations: safety check failures (empty for a valid plan; non-empty only if not raise_on_violation).
@@ -249,9 +258,3 @@ class Plan:
         """Relative motion-time saving over the honest stop-and-go baseline (0.15 = 15 % faster)."""
         return 1.0 - self.motion_s / self.stop_and_go_motion_s if self.stop_and_go_motion_s > 0 else 0.0
 
-    def to_json_dict(self) -> dict[str, Any]:
-        """JSON-ready summary (see :func:`ur3hanoi.plan.export.plan_json_dict`)."""
-        # Imported here: export reads plans, so a module-level import would be circular.
-        from ur3hanoi.plan.export import plan_json_dict
-
-        return plan_json_dict(self)

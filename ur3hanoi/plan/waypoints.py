@@ -9,7 +9,7 @@ from functools import lru_cache
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.plan.vertical import VerticalPath, vertical_path
+from ur3hanoi.plan.motion.vertical import VerticalPath, vertical_path
 from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import Station
 from ur3hanoi.waypoints import generate_table

@@ -34,7 +34,7 @@ def ruckig_halt(q0: FloatArray, v0: FloatArray, a0: FloatArray, station: Station
                 target_q: FloatArray | None) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Jerk-limited samples (q, qd, qdd) every ``dt`` [s] from a state to rest (``target_q`` None) or to a pose.
 
-    Uses the project's one Ruckig wrapper (:mod:`ur3hanoi.plan.ruckig`); a failure names Ruckig's result.
+    Uses the project's one Ruckig wrapper (:mod:`ur3hanoi.plan.motion.ruckig`); a failure names Ruckig's result.
     """
     lim = station.limits
     # Stopping uses the full acceleration/jerk budget even at reduced speed: the arm must come to rest soon.

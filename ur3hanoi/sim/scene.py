@@ -47,12 +47,22 @@ class SceneConfig:
         friction: sliding friction of blocks and table.
         weld_solref: (timeconst [s], dampratio) of the suction weld: stiff enough that a block slips < 1 mm in a
             full-speed swing, soft enough to stay stable at the 2 ms step.
+        noslip_iterations: MuJoCo's no-slip solver passes. Without them the soft contacts let a resting stack
+            creep sideways (measured: the top of a 4-block stack slid 0.1-0.2 mm/s with nothing touching it), and
+            since a grasp keeps the block's offset in the cup, the creep accumulated into 5-8 mm misplacements
+            and a torn-off block on a 6-block tall grid. Wooden blocks do not creep: the no-slip pass removes it.
+        contact_solref: (timeconst [s], dampratio) of the blocks' and the table's contacts. MuJoCo's default
+            (0.02 s) lets each contact sink about 0.45 mm under a stack (2.3 mm for 6 blocks), so a block placed on
+            a tall stack was pressed into it and sprang sideways when released (0.3-0.5 mm per release). 0.004 s,
+            the stiffest stable at the 2 ms step (2 steps), keeps wooden blocks nearly rigid.
     """
 
     timestep: float = 0.002
     block_mass: float = 0.0225
     friction: float = 1.0
     weld_solref: tuple[float, float] = (0.01, 1.0)
+    noslip_iterations: int = 10
+    contact_solref: tuple[float, float] = (0.004, 1.0)
 
 
 def slot_centers(station: Station) -> FloatArray:
@@ -103,6 +113,7 @@ def build_task_spec(station: Station, start: int, n_blocks: int, removed: int | 
         raise SimulationError(f"{SCENE_XML} is missing: run python -m ur3hanoi.sim")
     spec = mujoco.MjSpec.from_file(str(SCENE_XML))
     spec.option.timestep = cfg.timestep
+    spec.option.noslip_iterations = cfg.noslip_iterations
     if cfg.timestep > 0.002 + 1e-12:
         raise SimulationError(f"physics timestep {cfg.timestep} s is too long: expected <= 0.002 s")
 
@@ -131,7 +142,7 @@ def build_task_spec(station: Station, start: int, n_blocks: int, removed: int | 
         name="table", type=mujoco.mjtGeom.mjGEOM_BOX,
         pos=[*(0.5 * (lo + hi)), tz - 0.5 * TABLE_THICKNESS],
         size=[*(0.5 * (hi - lo)), 0.5 * TABLE_THICKNESS],
-        rgba=[0.55, 0.4, 0.28, 1.0], friction=[cfg.friction, 0.005, 0.0001],
+        rgba=[0.55, 0.4, 0.28, 1.0], friction=[cfg.friction, 0.005, 0.0001], solref=list(cfg.contact_solref),
     )
     floor = spec.geom("floor")
     floor.pos = [0.0, 0.0, min(0.0, tz - TABLE_THICKNESS)]  # below the slab, never through it
@@ -147,7 +158,7 @@ def build_task_spec(station: Station, start: int, n_blocks: int, removed: int | 
         body.add_geom(
             name=f"{block_name(b)}_geom", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.5 * s] * 3,
             mass=cfg.block_mass, rgba=list(BLOCK_RGBA.get(block_colour(b), (0.3, 0.3, 0.9, 1.0))),
-            friction=[cfg.friction, 0.005, 0.0001],
+            friction=[cfg.friction, 0.005, 0.0001], solref=list(cfg.contact_solref),
         )
         spec.add_equality(
             name=f"suction_{block_name(b)}", type=mujoco.mjtEq.mjEQ_WELD, objtype=mujoco.mjtObj.mjOBJ_BODY,

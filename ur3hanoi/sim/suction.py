@@ -26,8 +26,10 @@ class SuctionConfig:
             the block's expected suction point at contact: top-face centre minus ``contact_depth`` along world z
             (the lab rule: within 0.01 m of the grasp point; measured against the contact point because the
             calibrations put the suction point ``contact_depth`` below the top face).
-        hold_tolerance: a welded block counts as held while its expected suction point is within this
-            distance [m] of the suction point (a weld stretched further means it is being torn off).
+        hold_tolerance: a welded block counts as held while the weld is stretched less than this [m]: the
+            distance of the block's centre from where the weld holds it (its pose in the cup when grasped). A
+            block grasped off-centre (anywhere within ``grasp_radius``) is held as firmly as a centred one; only a
+            weld stretched further means the block is being torn off.
         ain_holding, ain_on_empty, ain_off: ``AIN0`` [V] holding a block, suction on with nothing held, suction
             off (the course simulator's values).
         ain_noise: standard deviation [V] of the seeded Gaussian noise on ``AIN0``.
@@ -63,6 +65,7 @@ class SuctionCup:
         self.rng = np.random.default_rng(seed)
         self.on = False
         self.attached: int | None = None
+        self._rel_pos = np.zeros(3)  # block centre in the cup frame when grasped [m]
         self.grasp_enabled = True  # cleared while halting: a faulted cup must not pick anything up
         st = scene.station
         # Block centre -> suction point at contact; constant, and read every control cycle by held().
@@ -110,6 +113,7 @@ class SuctionCup:
         m.eq_data[eq, 6:10] = rel_quat
         d.eq_active[eq] = 1
         self.attached = block
+        self._rel_pos = rel_pos.copy()
 
     def _detach(self) -> None:
         assert self.attached is not None
@@ -123,11 +127,19 @@ class SuctionCup:
             self._detach()
         return block
 
+    def stretch(self) -> float:
+        """How far [m] the held block's centre is from where the weld holds it (0 when nothing is held)."""
+        if self.attached is None:
+            return 0.0
+        d = self.scene.data
+        c = self.scene.cup_body
+        held_at = d.xpos[c] + d.xmat[c].reshape(3, 3) @ self._rel_pos
+        return float(np.linalg.norm(self.scene.block_pos(self.attached) - held_at))
+
     def held(self) -> bool:
         if not self.on or self.attached is None:
             return False
-        p_cup = self.scene.data.site_xpos[self.scene.site_id]
-        return float(np.linalg.norm(self.expected_suction_point(self.attached) - p_cup)) <= self.config.hold_tolerance
+        return self.stretch() <= self.config.hold_tolerance
 
     def feedback(self) -> GripperInput:
         """The emulated ``gripper_input`` now (seeded noise on ``AIN0``)."""

@@ -3,14 +3,14 @@
 The planner reuses one Ruckig trajectory for every repetition of a leg or a motion across, so the distances of a
 segment's moving geometry (robot, cup, carried block) to every slot a block can rest in depend on the segment
 alone. :class:`SegmentClearance` computes them in the segment's own time, on demand per (mover, slot), and keeps
-them; :func:`check_segments` applies the rules of :func:`~ur3hanoi.plan.collision.clearance_rules` to each
+them; :func:`check_segments` applies the rules of :func:`~ur3hanoi.plan.checks.collision.clearance_rules` to each
 segment of a plan with the blocks resting at that moment. A long solve checks each distinct motion once instead of
 every sample of every move.
 
 Guarantee (continuous time, resolved to 1 ms): the segment is cut at ``1 / collision_rate_hz`` and at its end.
 Between two cuts no point of the moving geometry is farther than ``delta = sum_i vb_i R_i (t_b - t_a) / 2`` from
 its position at the nearer cut (``vb_i`` bounds joint i's speed in between: the larger end speed plus
-``a_max dt / 2``; ``R_i`` as in :class:`~ur3hanoi.plan.collision.CollisionScene`). A pair is proven clear on an
+``a_max dt / 2``; ``R_i`` as in :class:`~ur3hanoi.plan.checks.collision.CollisionScene`). A pair is proven clear on an
 interval when its distance at both cuts exceeds the requirement by ``delta``: first with bounding spheres against the
 block box (a few numpy operations for every slot at once), then with the exact coal distance, and otherwise the
 interval is halved until it is proven or 1 ms long (where the distances at its ends decide, as a 1 kHz check
@@ -32,8 +32,8 @@ import pinocchio as pin
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.grid import block_center_world, table_z
 from ur3hanoi.hanoi import Move, stacks_before_moves
-from ur3hanoi.plan.collision import MAX_REPORTED, CollisionScene, clearance_rules, resting_blocks
-from ur3hanoi.plan.sampling import evaluate
+from ur3hanoi.plan.checks.collision import MAX_REPORTED, CollisionScene, clearance_rules, resting_blocks
+from ur3hanoi.plan.motion.sampling import evaluate
 from ur3hanoi.plan.types import KinematicLimits, Phase, PlanConfig, Segment
 from ur3hanoi.plan.waypoints import geometry_key
 from ur3hanoi.robot import DH_A, DH_ALPHA, DH_D, N_JOINTS, T_BASELINK_BASE, dh_link

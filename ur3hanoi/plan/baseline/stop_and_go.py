@@ -6,7 +6,7 @@
   faster than any motion that keeps the line: the plan must beat it anyway.
 - :func:`exact_vertical_motion_s` (``Plan.exact_vertical_stop_and_go_duration_s``): the same, with every approach
   and retreat following the vertical line exactly, timed by a 1-DoF Ruckig of the path coordinate under limits
-  constant along the path (:class:`~ur3hanoi.plan.vertical.PathLimits`): the reference this project used before
+  constant along the path (:class:`~ur3hanoi.plan.motion.vertical.PathLimits`): the reference this project used before
   the honest one, reported for comparison.
 
 Both are motion times [s] (dwells excluded).
@@ -18,8 +18,8 @@ import itertools
 from collections.abc import Sequence
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.plan.builder import Hop
-from ur3hanoi.plan.connections import StationPlanner
+from ur3hanoi.plan.route.builder import Hop
+from ur3hanoi.plan.route.connections import StationPlanner
 
 
 def _waypoints(planner: StationPlanner, hop: Hop) -> list[FloatArray]:

@@ -1,4 +1,4 @@
-"""The Nelder-Mead minimiser (ur3hanoi.plan.optimize): minimum, stopping rules, infeasible points, determinism."""
+"""The Nelder-Mead minimiser (plan.motion.minimize, SciPy): minimum, stopping rules, infeasible points, determinism."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ur3hanoi.plan.optimize import nelder_mead
+from ur3hanoi.plan.motion.minimize import nelder_mead
 
 
 @settings(max_examples=30, deadline=None, derandomize=True)

@@ -3,19 +3,19 @@
 Each move visits previous place -> above(src) -> on(src) -> [suction on, dwell] -> above(src) -> above(dst) ->
 on(dst) -> [suction off, dwell] -> above(dst); the plan starts and ends at home with suction off. A *hop*
 (:class:`Hop`) is everything between two dwells (or home): retreat/lift, the motion across, descend; the builder
-turns each into a :class:`~ur3hanoi.plan.connections.Connection` and lays the connections and dwells end to end.
-Every segment is one offline Ruckig calculation (:mod:`ur3hanoi.plan.ruckig`); the end state of one is the start
+turns each into a :class:`~ur3hanoi.plan.route.connections.Connection` and lays the connections and dwells end to end.
+Every segment is one offline Ruckig calculation (:mod:`ur3hanoi.plan.motion.ruckig`); the end state of one is the start
 state of the next.
 
 - Pass-through: the robot does not stop at the above poses; the via states there, and the approach legs, are
-  described in :mod:`ur3hanoi.plan.legs` and :mod:`ur3hanoi.plan.via`.
+  described in :mod:`ur3hanoi.plan.motion.legs` and :mod:`ur3hanoi.plan.motion.via`.
 - Tall towers: a hop rises over the towers on its way when they are taller than its above poses
   (:func:`plan_hops`): to "over" points on the two slots' vertical lines, at rest, high enough for the carried block
   (or the empty cup) to clear the tallest stack on the towers it passes (the towers between the two, by index:
   the grid's towers stand in a row) by the clearance plus :data:`OVER_MARGIN_M`.
 - Stop-and-go (``pass_through=False``): the same waypoints with zero velocity at each, the same dwells and limits.
 
-Connections are memoized per station (:func:`~ur3hanoi.plan.connections.station_planner`): a Hanoi solve revisits
+Connections are memoized per station (:func:`~ur3hanoi.plan.route.connections.station_planner`): a Hanoi solve revisits
 the same few slot pairs over and over, and a repeated hop reuses the same trajectories, hence the same segments.
 """
 
@@ -30,8 +30,8 @@ from ruckig import Trajectory as RuckigTrajectory
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.grid import block_center_world, contact_point_world
 from ur3hanoi.hanoi import Move, stacks_before_moves
-from ur3hanoi.plan.connections import Connection, StationPlanner, station_planner
-from ur3hanoi.plan.legs import Leg, State
+from ur3hanoi.plan.motion.legs import Leg, State
+from ur3hanoi.plan.route.connections import Connection, StationPlanner, station_planner
 from ur3hanoi.plan.types import Phase, PlanConfig, Segment
 from ur3hanoi.robot import N_JOINTS
 from ur3hanoi.station import Station

@@ -4,8 +4,8 @@ the table and the resting blocks (Pinocchio geometry, coal distances), decimated
 The rules (which clearances are required in which phase, and which are excluded as contact by design) are
 :func:`clearance_rules` over the resting blocks of :func:`resting_blocks`; see :class:`CollisionScene` for the
 geometry, the required distances and the decimation argument. :func:`check_collisions` checks a sampled
-trajectory (any trajectory); the planner checks its segments with :mod:`ur3hanoi.plan.clearance`, which applies the
-same rules once per distinct segment.
+trajectory (any trajectory); the planner checks its segments with :mod:`ur3hanoi.plan.checks.clearance`, which
+applies the same rules once per distinct segment.
 """
 
 from __future__ import annotations

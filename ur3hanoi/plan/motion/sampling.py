@@ -27,8 +27,8 @@ import numpy.typing as npt
 from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
+from ur3hanoi.plan.motion.vertical import VerticalPath
 from ur3hanoi.plan.types import SUCTION_PHASES, Segment, Trajectory
-from ur3hanoi.plan.vertical import VerticalPath
 from ur3hanoi.robot import N_JOINTS
 
 _N_PIECES = 8  # pieces of a profile: 7 constant-jerk phases and the state after the end

@@ -3,7 +3,7 @@
 A connection joins the exit leg of the slot it leaves (lift/retreat, ending at the above pose in the via state of
 its cell), the joint-space motion across, and the entry leg of the slot it enters (descend, starting at the above
 pose in the via state of its cell); its cost is the sum ``exit(c0) + across(c0, c1) + entry(c1)``. The cells of
-each slot form a small grid (:class:`~ur3hanoi.plan.legs.SlotLegs`): :func:`best_cells` searches the product.
+each slot form a small grid (:class:`~ur3hanoi.plan.motion.legs.SlotLegs`): :func:`best_cells` searches the product.
 
 Each leg has a cheap lower bound (one Ruckig calculation) and an exact duration (the verified leg through interior
 points: a small optimisation). The search descends on the costs with the bounds in place of the legs it has not

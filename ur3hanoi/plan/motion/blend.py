@@ -7,9 +7,9 @@ acceleration ``u`` [m/s^2] of the suction point toward the other slot to the via
 ``u J^-1 e``, ``e`` the horizontal unit vector from one slot to the other; the acceleration is negative on the
 entry side: the arm is ending its motion across). The exit side is blended first, then the entry side. (u, w)
 minimise the duration of the two segments they change (the top segment of the leg and the adjacent segment across:
-a small Nelder-Mead search, :func:`~ur3hanoi.plan.optimize.nelder_mead`), and are then scaled back (bisection)
+a small Nelder-Mead search, :func:`~ur3hanoi.plan.motion.minimize.nelder_mead`), and are then scaled back (bisection)
 until the changed leg segment passes the same forward-kinematics check at 1 kHz as every leg
-(:meth:`~ur3hanoi.plan.legs.SlotLegs.corridor`). Measured gain (3 blocks): 1.1 % of the motion on lab_sim, 6 % on
+(:meth:`~ur3hanoi.plan.motion.legs.SlotLegs.corridor`). Measured gain (3 blocks): 1.1 % of the motion on lab_sim, 6 % on
 lab_real, where every move turns the base (worst distance from the line 1.0 -> 1.8 mm there).
 """
 
@@ -23,9 +23,9 @@ import numpy as np
 from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.plan.legs import CONTACT_OVERSHOOT_M, DENSE_MARGIN_M, Leg, SlotLegs, State, within_limits
-from ur3hanoi.plan.optimize import nelder_mead
-from ur3hanoi.plan.ruckig import OfflineRuckig
+from ur3hanoi.plan.motion.legs import CONTACT_OVERSHOOT_M, DENSE_MARGIN_M, Leg, SlotLegs, State, within_limits
+from ur3hanoi.plan.motion.minimize import nelder_mead
+from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 from ur3hanoi.plan.types import KinematicLimits
 
 # The search over (u, w) per side: u in units of the largest u the acceleration limits allow, w [m/s]. It starts
@@ -49,7 +49,7 @@ def _max_scale(state: State, h: FloatArray, limits: KinematicLimits, sign: float
 
 
 class Blender:
-    """Adds the lateral via accelerations of :mod:`ur3hanoi.plan.blend` to a connection's two above states."""
+    """Adds the lateral via accelerations of :mod:`ur3hanoi.plan.motion.blend` to a connection's two above states."""
 
     def __init__(self, ruckig: OfflineRuckig, limits: KinematicLimits, tol_m: float) -> None:
         self.ruckig = ruckig

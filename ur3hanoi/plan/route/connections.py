@@ -3,9 +3,9 @@
 A connection is everything between two grasp/release dwells (or home): the exit leg of the slot it leaves
 (lift or retreat), the joint-space Ruckig motion across to the slot it enters (through "over" points when towers on
 the way are taller than the above poses), and that slot's entry leg (descend). Its via cells (the states at the two
-above poses) are chosen by :func:`~ur3hanoi.plan.via.best_cells` for the least summed duration; the legs come
-from :class:`~ur3hanoi.plan.legs.SlotLegs`; then :class:`~ur3hanoi.plan.blend.Blender` starts the motion across
-inside the corridor at both above poses. The over points are passed at rest (tall grids only: the lab's towers
+above poses) are chosen by :func:`~ur3hanoi.plan.motion.via.best_cells` for the least summed duration; the legs come
+from :class:`~ur3hanoi.plan.motion.legs.SlotLegs`; then :class:`~ur3hanoi.plan.motion.blend.Blender` starts the motion
+across inside the corridor at both above poses. The over points are passed at rest (tall grids only: the lab's towers
 never need them).
 
 :func:`station_planner` returns the :class:`StationPlanner` of a station and its planning limits, built once and
@@ -28,12 +28,12 @@ from ruckig import Trajectory as RuckigTrajectory
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
 from ur3hanoi.grid import ABOVE, contact_point_world
-from ur3hanoi.plan.blend import Blender, lateral_direction
-from ur3hanoi.plan.legs import Cell, Leg, SlotLegs, State, within_limits
-from ur3hanoi.plan.ruckig import OfflineRuckig
+from ur3hanoi.plan.motion.blend import Blender, lateral_direction
+from ur3hanoi.plan.motion.legs import Cell, Leg, SlotLegs, State, within_limits
+from ur3hanoi.plan.motion.ruckig import OfflineRuckig
+from ur3hanoi.plan.motion.vertical import PathLimits, line_ik
+from ur3hanoi.plan.motion.via import Pair, best_cells
 from ur3hanoi.plan.types import KinematicLimits
-from ur3hanoi.plan.vertical import PathLimits, line_ik
-from ur3hanoi.plan.via import Pair, best_cells
 from ur3hanoi.plan.waypoints import Waypoints, build_waypoints, geometry_key
 from ur3hanoi.robot import N_JOINTS, load_ur3
 from ur3hanoi.station import Station
@@ -41,7 +41,7 @@ from ur3hanoi.station import Station
 Slot = tuple[int, int]  # (tower, height), 0-based
 
 # Start of the via search, in the grid's units (vb, vb / T0): near the optimum of the lab stations' connections.
-SEARCH_START = (2.25, 2.0)
+SEARCH_START = (2.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -75,9 +75,9 @@ class StationPlanner:
         station: the station.
         limits: the planning limits.
         tol_m: allowed distance [m] of the suction point from the vertical line on approach and retreat.
-        via_speeds, via_accels: the via grid (see :mod:`ur3hanoi.plan.legs`); ``pass_through`` False plans
+        via_speeds, via_accels: the via grid (see :mod:`ur3hanoi.plan.motion.legs`); ``pass_through`` False plans
             every via at rest.
-        blend: add the lateral via accelerations of :mod:`ur3hanoi.plan.blend` (pass-through only).
+        blend: add the lateral via accelerations of :mod:`ur3hanoi.plan.motion.blend` (pass-through only).
     """
 
     def __init__(self, station: Station, limits: KinematicLimits, tol_m: float, via_speeds: tuple[float, ...],
@@ -265,7 +265,7 @@ class StationPlanner:
 
     def exact_vertical_leg(self, slot: Slot) -> float:
         """Duration [s] of the rest-to-rest leg that follows the slot's vertical line exactly: a 1-DoF Ruckig of the
-        path coordinate under :class:`~ur3hanoi.plan.vertical.PathLimits` (memoized)."""
+        path coordinate under :class:`~ur3hanoi.plan.motion.vertical.PathLimits` (memoized)."""
         if slot not in self._exact_leg:
             vp = self.wp.vertical[slot[0]][slot[1]]
             pl = PathLimits.for_path(vp, self.limits)

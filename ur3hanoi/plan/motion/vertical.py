@@ -3,11 +3,11 @@
 A straight joint-space line between a slot's above and on poses bends the suction point up to ~10 mm off the
 vertical on the lab stations. :class:`VerticalPath` is the line itself: closed-form IK points on it (on home's
 branch) every few millimetres, interpolated by a cubic Hermite spline of (q, dq/ds). The approach legs
-(:mod:`ur3hanoi.plan.legs`) take their interior points and tangents from it. Following it exactly with a 1-DoF
+(:mod:`ur3hanoi.plan.motion.legs`) take their interior points and tangents from it. Following it exactly with a 1-DoF
 Ruckig trajectory of the path coordinate ``s`` [m] under :class:`PathLimits` (constant limits that keep every joint
 within its own) is the always-feasible fallback of a rest-to-rest leg and the "exact vertical" stop-and-go
-reference (:mod:`ur3hanoi.plan.baseline`); :func:`braking_speed` bounds the speed such a leg can stop from within
-a distance.
+reference (:mod:`ur3hanoi.plan.baseline.stop_and_go`); :func:`braking_speed` bounds the speed such a leg can stop
+from within a distance.
 """
 
 from __future__ import annotations
