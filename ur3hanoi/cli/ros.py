@@ -14,7 +14,7 @@ import os
 import sys
 from pathlib import Path
 
-from ur3hanoi.cli.common import DEFAULT_CALIBRATION
+from ur3hanoi.cli.common import DEFAULT_CALIBRATION, add_suction_profile_option
 from ur3hanoi.cli.options import (
     BLOCKS,
     CMD_ACCELERATION,
@@ -71,6 +71,7 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--report", metavar="FILE", help="write the JSON report to FILE (default: stdout)")
     p.add_argument("--duration", type=option(DURATION), metavar="S", help="stop by itself after S seconds")
     p.add_argument("--master", metavar="URI", help=_master_help())
+    add_suction_profile_option(p)
     out = p.add_mutually_exclusive_group()
     out.add_argument("--video", metavar="FILE.mp4", help="render an MP4 offscreen (headless: MUJOCO_GL=egl)")
     out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR")
@@ -88,7 +89,7 @@ def _run_station(args: argparse.Namespace) -> int:
         drop_on_grasp=None if args.drop_on_grasp is None else args.drop_on_grasp - 1, seed=args.seed,
         rate_hz=args.rate, report=Path(args.report) if args.report else None,
         frames=Path(args.frames) if args.frames else None, video=Path(args.video) if args.video else None,
-        duration_s=args.duration, master_uri=args.master)
+        duration_s=args.duration, master_uri=args.master, suction_profile=args.suction_profile)
     report = RosStation(options).run()
     if args.report:
         c, ctl = report["commands"], report["control"]
