@@ -29,6 +29,11 @@ def robot_dir() -> Path:
     return _package_dir("robots", ROBOT_NAME)
 
 
+def robots_dir() -> Path:
+    """The folder of the robot model folders (``universal_robots_ur3``, ``universal_robots_ur3e``)."""
+    return _package_dir("robots")
+
+
 def stations_dir() -> Path:
     """The folder of the shipped station calibrations (and the example taught-points file)."""
     return _package_dir("stations")

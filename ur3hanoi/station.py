@@ -48,6 +48,7 @@ from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
 from ur3hanoi.resources import station_file, station_names
 from ur3hanoi.robot import FLANGE_FRAMES, N_JOINTS, JointLimits, ToolOffset
+from ur3hanoi.robot_registry import DEFAULT_ROBOT, ROBOTS, RobotDescription
 from ur3hanoi.suction_profile import (
     AIN_RANGE_V,
     DEFAULT_PROFILE,
@@ -89,6 +90,7 @@ class Station:
         sha256: hex digest of that file's bytes ("" if built in code).
         suction: what the suction feedback reads (``suction:`` section; the course simulator's levels by
             default), see :mod:`ur3hanoi.suction_profile`.
+        robot: the arm (``robot.model``; the UR3 by default), see :mod:`ur3hanoi.robot_registry`.
     """
 
     name: str
@@ -108,6 +110,7 @@ class Station:
     source: str = "<memory>"
     sha256: str = ""
     suction: SuctionProfile = DEFAULT_PROFILE
+    robot: RobotDescription = DEFAULT_ROBOT
 
     @property
     def n_towers(self) -> int:
@@ -168,6 +171,7 @@ STATION_SCHEMA = Record({
     "name": Field(Text(max_len=255), required=False),
     "layout": Field(Choice(LAYOUTS)),
     "robot": Field(Record({
+        "model": Field(Choice(tuple(ROBOTS)), required=False),
         "base_xyz": Field(_POINT),
         **_angles("base_rpy", 3),
         **_angles("home", N_JOINTS),
@@ -252,7 +256,8 @@ def parse_station(data: Any, source: str = "<memory>") -> Station:
 
     base_rpy = _angles_rad(source, robot, "robot", "base_rpy", 3, default=(0.0, 0.0, 0.0))
     elbow = math.radians(float(robot.get("elbow_limit_deg", 360.0)))
-    limits = JointLimits.ur3(elbow_limit=elbow)
+    arm = ROBOTS[robot.get("model", DEFAULT_ROBOT.name)]
+    limits = JointLimits.for_robot(arm, elbow_limit=elbow)
     q_home = _angles_rad(source, robot, "robot", "home", N_JOINTS)
     tool_rpy = _angles_rad(source, tool, "tool", "rpy", 3)
     tool_offset = ToolOffset(parent=tool["parent"], xyz=_vec3(tool["xyz"]), rpy=_vec3(tool_rpy))
@@ -290,7 +295,7 @@ def parse_station(data: Any, source: str = "<memory>") -> Station:
         name=name, layout=layout, base_xyz=_vec3(robot["base_xyz"]), base_rpy=_vec3(base_rpy), q_home=q_home,
         limits=limits, tool=tool_offset, tool_yaw=tool_yaw, block_size=block_size, contact_depth=depth,
         tower_origins=origins, height_step=_vec3(grid["height_step"]), n_heights=n_heights,
-        approach=float(grid["approach"]), source=source, suction=suction,
+        approach=float(grid["approach"]), source=source, suction=suction, robot=arm,
     )
     validate(station)
     return station
@@ -323,7 +328,8 @@ def validate(s: Station) -> None:
     src = s.source
     if not s.limits.within_position(s.q_home_array):
         raise fail(src, "robot.home_deg", [round(math.degrees(v), 6) for v in s.q_home],
-                   "joint angles within the UR3 limits (+-360 deg; elbow within robot.elbow_limit_deg)")
+                   f"joint angles within the {s.robot.name.upper()} limits (+-360 deg; elbow within "
+                   "robot.elbow_limit_deg)")
     step = np.array(s.height_step)
     horiz, vert = float(np.linalg.norm(step[:2])), float(step[2])
     if s.n_heights > 1 or np.linalg.norm(step) > 0:
@@ -357,6 +363,7 @@ def station_to_dict(s: Station) -> dict[str, Any]:
         "name": s.name,
         "layout": s.layout,
         "robot": {
+            **({} if s.robot == DEFAULT_ROBOT else {"model": s.robot.name}),
             "base_xyz": rnd(s.base_xyz),
             "base_rpy_deg": deg(s.base_rpy),
             "home_deg": deg(s.q_home),
