@@ -159,7 +159,7 @@ def urdf_text(tool: ToolOffset | None = None, absolute_meshes: bool = True, robo
 
         text = urdf_from_dh(robot)
     else:
-        text = urdf_path(robot).read_text()
+        text = (urdf_path() if robot == UR3 else urdf_path(robot)).read_text()
     if absolute_meshes:
         text = text.replace("package://", str(package_dir()) + "/")
     if tool is not None:

@@ -79,12 +79,6 @@ class RobotDescription:
     elbow_offset: float = 0.0925
     link_radius: tuple[float, float, float] = (0.045, 0.035, 0.03)
 
-    @property
-    def reach(self) -> float:
-        """Distance [m] from the joint-2 axis to the flange with the arm stretched (|a2| + |a3| + the wrist)."""
-        d = self.dh
-        return abs(d.a[1]) + abs(d.a[2]) + math.hypot(d.d[4], d.d[5])
-
 
 _SPEED = (math.pi,) * 3 + (2 * math.pi,) * 3  # 180 deg/s joints 1-3, 360 deg/s wrists (both datasheets)
 _ACC = (4.0,) * 3 + (8.0,) * 3
