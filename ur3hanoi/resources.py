@@ -40,7 +40,7 @@ def stations_dir() -> Path:
 
 
 def station_names() -> tuple[str, ...]:
-    """Names of the shipped stations, sorted (``("lab_real", "lab_sim")``)."""
+    """Names of the shipped stations, sorted (``("lab_real", "lab_sim", "ur3e_sim")``)."""
     return tuple(sorted(p.stem for p in stations_dir().glob("*.yaml") if p.name != TAUGHT_EXAMPLE))
 
 
