@@ -35,7 +35,7 @@ def test_ur3e_dh_is_urs_published_table() -> None:
     assert UR3E.dh.d == (0.15185, 0.0, 0.0, 0.13105, 0.08535, 0.0921)
     assert UR3E.dh.a == (0.0, -0.24355, -0.2132, 0.0, 0.0, 0.0)
     assert UR3E.v_max == pytest.approx([math.radians(180)] * 3 + [math.radians(360)] * 3, abs=1e-15)
-    assert sum(UR3E.masses) == pytest.approx(8.8185, abs=1e-12)  # links only; the datasheet's 11.2 kg adds the base
+    assert sum(UR3E.masses) == pytest.approx(8.7985, abs=1e-12)  # links only; the datasheet's 11.2 kg adds the base
 
 
 def test_ur3_entry_is_the_module_constants() -> None:
