@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 from cyclonedds.idl import IdlStruct
 from cyclonedds.idl.annotations import final
-from cyclonedds.idl.types import array, float64, int32, sequence, uint8
+from cyclonedds.idl.types import array, bounded_str, float64, int32, sequence, uint8
 
 MSG_TEXT: dict[str, str] = {
     "ur3e_mrc_msgs/msg/CommandUR3e": "float64[] destination\nfloat64 v\nfloat64 a\nbool io_0\n",
@@ -84,8 +84,11 @@ class Gid(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):  # type: ignor
 @dataclass
 @final
 class NodeEntitiesInfo(IdlStruct, typename="rmw_dds_common::msg::dds_::NodeEntitiesInfo_"):  # type: ignore[call-arg]
-    node_namespace: str = "/"
-    node_name: str = ""
+    """A node's name and its endpoints. The names are ``string<256>`` as in rmw_dds_common's IDL: Fast DDS 3
+    (Kilted) compares XTypes type objects, where an unbounded string is another type (no match, no node name)."""
+
+    node_namespace: bounded_str[256] = "/"
+    node_name: bounded_str[256] = ""
     reader_gid_seq: sequence[Gid] = field(default_factory=list)
     writer_gid_seq: sequence[Gid] = field(default_factory=list)
 
