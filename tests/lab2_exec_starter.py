@@ -6,8 +6,11 @@ a fixed ``time.sleep`` before reading ``DIGIN & 1``, prompts for the start and e
 
 Differences from the course file, all outside the robot interface: the table path comes from ``--yaml`` (the
 course finds it with rospkg), ``yaml.safe_load`` (PyYAML 6 needs a loader), Python 3's ``input``, and
-``move_block``/``solve`` filled in as a student would. Run against ``ur3hanoi ros-station`` with the environment
-of ``ur3hanoi ros-env`` (no catkin workspace): ``tests/test_ros_station.py`` does.
+``move_block``/``solve`` filled in as a student would. ``--ain0-below V`` switches the block check to the
+analog one public programs written on the real robot use: lift to the "above" pose, then halt when
+``AIN0 < V`` (thresholds 1.75..2.0 V appear; they were calibrated on real stations). Run against
+``ur3hanoi ros-station`` with the environment of ``ur3hanoi ros-env`` (no catkin workspace):
+``tests/test_ros_station.py`` does.
 """
 
 import argparse
@@ -41,6 +44,9 @@ current_io_0 = False
 current_position_set = False
 
 Q = None
+
+# None: check DIGIN & 1 after the grasp sleep; a voltage: check AIN0 < it after lifting (real-robot programs).
+AIN0_BELOW = None
 
 
 def position_callback(msg):
@@ -166,7 +172,7 @@ def move_block(pub_cmd, loop_rate, start_loc, start_height, end_loc, end_height,
     # Delay to make sure suction cup has grasped the block
     time.sleep(1.0)
 
-    if (digital_in_0 & 1) == 0:
+    if AIN0_BELOW is None and (digital_in_0 & 1) == 0:
         gripper(pub_cmd, loop_rate, suction_off)
         move_arm(pub_cmd, loop_rate, home, vel, accel)
         rospy.logerr("Block not found at tower " + str(start_loc + 1) + " height " + str(start_height + 1))
@@ -174,6 +180,14 @@ def move_block(pub_cmd, loop_rate, start_loc, start_height, end_loc, end_height,
         return error
 
     move_arm(pub_cmd, loop_rate, Q[start_loc][start_height][1], vel, accel)
+    sensed = analog_in_0
+    if AIN0_BELOW is not None and sensed < AIN0_BELOW:
+        gripper(pub_cmd, loop_rate, suction_off)
+        move_arm(pub_cmd, loop_rate, home, vel, accel)
+        rospy.logerr("Block not found at tower " + str(start_loc + 1) + " height " + str(start_height + 1)
+                     + " (AIN0 = " + str(round(sensed, 3)) + " V)")
+        error = 1
+        return error
     move_arm(pub_cmd, loop_rate, Q[end_loc][end_height][1], vel, accel)
     move_arm(pub_cmd, loop_rate, Q[end_loc][end_height][0], vel, accel)
     gripper(pub_cmd, loop_rate, suction_off)
@@ -212,11 +226,14 @@ def main():
 
     global home
     global Q
+    global AIN0_BELOW
 
     parser = argparse.ArgumentParser()
     parser.add_argument("--simulator", type=str, default="True")
     parser.add_argument("--yaml", type=str, default="lab2_data.yaml")
+    parser.add_argument("--ain0-below", type=float, default=None)
     args = parser.parse_args()
+    AIN0_BELOW = args.ain0_below
 
     with open(args.yaml) as f:
         data = yaml.safe_load(f)

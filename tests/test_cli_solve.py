@@ -80,3 +80,15 @@ def test_cli_rejects_bad_fault_arguments(capsys: pytest.CaptureFixture[str]) -> 
     assert cli.main(["solve", "--start", "1", "--end", "1"]) == 2
     err = capsys.readouterr().err
     assert "--remove-block 4 is invalid" in err and "--drop-during-move 8 is invalid" in err
+
+
+@pytest.mark.parametrize(("option", "profile", "free_v"), [([], "lab_sim", 1.45),
+                                                            (["--suction-profile", "real"], "real", 1.40)])
+def test_cli_solve_reports_the_suction_profile_it_reads(capsys: pytest.CaptureFixture[str], option: list[str],
+                                                        profile: str, free_v: float) -> None:
+    """The JSON names the profile, and the halt message's AIN0 is that profile's cup-free level."""
+    code = cli.main(["solve", "--start", "1", "--end", "2", "--remove-block", "3", "--json", *option])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 3 and out["suction"]["profile"] == profile
+    ain0 = float(out["error"].split("AIN0=")[1].split(" V")[0])
+    assert abs(ain0 - free_v) < 0.1

@@ -22,7 +22,7 @@ def test_data_lives_inside_the_package_not_the_working_directory() -> None:
 
 
 def test_shipped_stations_are_named_and_the_example_taught_file_is_not_one() -> None:
-    assert station_names() == ("lab_real", "lab_sim")
+    assert station_names() == ("lab_real", "lab_sim", "ur3e_sim")
     assert (stations_dir() / TAUGHT_EXAMPLE).is_file() and "taught_example" not in station_names()
 
 

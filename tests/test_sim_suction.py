@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import mujoco
 import numpy as np
 import pytest
 
 from ur3hanoi.sim import SuctionConfig, SuctionCup, TaskScene, build_task_scene
+from ur3hanoi.suction_profile import LAB_SIM, REAL, with_levels
 from ur3hanoi.waypoints import generate_table
 
 from .sim_helpers import STATIONS
@@ -30,7 +33,8 @@ def scene_at_contact(name: str, offset: np.ndarray | None = None) -> TaskScene:
 def test_suction_grasps_without_jump_and_reports_feedback(name: str) -> None:
     scene = scene_at_contact(name)
     cup = SuctionCup(scene, seed=1)
-    assert not cup.feedback().held and abs(cup.feedback().ain0 - 1.05) < 0.05
+    levels = STATIONS[name].suction  # lab_sim: the course simulator's; lab_real: the `real` profile
+    assert not cup.feedback().held and abs(cup.feedback().ain0 - levels.ain0_off) < 0.1
     before = scene.block_pos(2)
     cup.command(True)
     cup.update()
@@ -38,10 +42,10 @@ def test_suction_grasps_without_jump_and_reports_feedback(name: str) -> None:
     mujoco.mj_step(scene.model, scene.data, nstep=50)
     assert np.linalg.norm(scene.block_pos(2) - before) < 5e-4  # the weld starts at the current relative pose
     fb = cup.feedback()
-    assert fb.digin == 1 and abs(fb.ain0 - 1.9) < 0.05
+    assert fb.digin == 1 and abs(fb.ain0 - levels.ain0_held) < 0.1
     cup.command(False)
     fb = cup.feedback()
-    assert fb.digin == 0 and abs(fb.ain0 - 1.05) < 0.05 and cup.attached is None
+    assert fb.digin == 0 and abs(fb.ain0 - levels.ain0_off) < 0.1 and cup.attached is None
 
 
 @pytest.mark.parametrize(("dist", "grasped"), [(0.009, True), (0.011, False)])
@@ -81,3 +85,44 @@ def test_seeded_noise_is_reproducible_and_seed_dependent() -> None:
     assert ain0(3) == ain0(3)
     assert ain0(3) != ain0(4)
     assert max(abs(v - 1.05) for v in ain0(3)) < 0.05  # 0.01 V noise around the suction-off level
+
+
+def test_profiles_set_the_levels_of_every_state() -> None:
+    """held / cup free / off read the profile's DIGIN and AIN0 (noise off: exactly), for a named and a custom one."""
+    custom = with_levels(REAL, {"ain0_held": 3.1, "digin_held": 3, "digin_free": 2})
+    assert custom.name == "custom"
+    for profile in (LAB_SIM, REAL, custom):
+        cup = SuctionCup(scene_at_contact("lab_sim"), SuctionConfig(profile=profile, ain_noise=0.0))
+        off = cup.feedback()
+        cup.command(True)
+        free = cup.feedback()
+        cup.update()
+        held = cup.feedback()
+        assert (held.digin, held.ain0) == (profile.digin_held, profile.ain0_held)
+        assert (free.digin, free.ain0) == (profile.digin_free, profile.ain0_free)
+        assert (off.digin, off.ain0) == (profile.digin_off, profile.ain0_off)
+    assert not SuctionCup(scene_at_contact("lab_sim"), SuctionConfig(profile=custom)).feedback().held
+
+
+def test_the_cup_reads_the_station_profile_by_default() -> None:
+    station = replace(STATIONS["lab_sim"], suction=REAL)
+    scene = build_task_scene(station, 0, 3)
+    cup = SuctionCup(scene, seed=2)
+    assert cup.profile == REAL
+    samples = np.array([cup.feedback().ain0 for _ in range(2000)])
+    # The profile's noise: mean within 4 standard errors, standard deviation within 10 %.
+    assert abs(samples.mean() - REAL.ain0_off) < 4 * REAL.ain0_noise / np.sqrt(len(samples))
+    assert abs(samples.std() - REAL.ain0_noise) < 0.1 * REAL.ain0_noise
+
+
+@pytest.mark.parametrize("threshold", [1.75, 1.8, 1.95, 2.0])
+def test_real_profile_separates_every_public_threshold(threshold: float) -> None:
+    """Programs written on real robots decide "missing" by AIN0 < t, t in 1.75..2.0 V: with the real profile a held
+    block reads above every t and a free cup below it, in 20,000 noisy samples; with lab_sim a held block reads
+    below t = 1.95 and 2.0 (the false halt real-robot programs hit on the course simulator's levels)."""
+    rng = np.random.default_rng(7)
+    held = REAL.ain0_held + rng.normal(0.0, REAL.ain0_noise, 20_000)
+    free = REAL.ain0_free + rng.normal(0.0, REAL.ain0_noise, 20_000)
+    assert held.min() > threshold > free.max()
+    sim_held = LAB_SIM.ain0_held + rng.normal(0.0, LAB_SIM.ain0_noise, 20_000)
+    assert bool(sim_held.max() < threshold) is (threshold > 1.9)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -12,7 +13,9 @@ import pytest
 import yaml
 
 from ur3hanoi.errors import CalibrationError
-from ur3hanoi.station import Station, load_station, parse_station, station_to_dict
+from ur3hanoi.station import Station, load_station, parse_station, station_to_dict, with_suction_profile
+from ur3hanoi.suction_profile import LAB_SIM as SIM_LEVELS
+from ur3hanoi.suction_profile import REAL
 
 from .conftest import LAB_REAL, LAB_SIM
 
@@ -58,6 +61,7 @@ def test_round_trip_through_station_to_dict(shipped_station: Station) -> None:
         assert p == pytest.approx(q, abs=1e-12)
     assert again.q_home == pytest.approx(shipped_station.q_home, abs=1e-12)
     assert again.tool == shipped_station.tool or again.tool.rpy == pytest.approx(shipped_station.tool.rpy)
+    assert again.suction == shipped_station.suction
 
 
 def _mutated(path: Path, dotted: str, value: Any) -> dict[str, Any]:
@@ -97,6 +101,12 @@ BAD_FIELDS = [
     ("grid.tower_step", [0.0, 0.01, 0.0], "grid.tower_origins"),
     ("grid.approach", -0.1, "grid.approach"),
     ("grid.approach", float("inf"), "grid.approach"),
+    ("suction", {"profile": "vacuum"}, "suction.profile"),
+    ("suction", {"ain0_held": 12.0}, "suction.ain0_held"),
+    ("suction", {"ain0_noise": -0.01}, "suction.ain0_noise"),
+    ("suction", {"digin_held": 1.5}, "suction.digin_held"),
+    ("suction", {"digin_free": True}, "suction.digin_free"),
+    ("suction", "real", "suction"),
 ]
 
 
@@ -186,7 +196,8 @@ def test_typo_base_rpy_is_an_error_with_the_suggestion(tmp_path: Path) -> None:
     ("dotted", "value", "message"),
     [
         ("grids", {}, "field 'grids' is unknown: did you mean 'grid'?"),
-        ("colour", "red", "field 'colour' is unknown: expected one of name, layout, robot, tool, blocks, grid"),
+        ("colour", "red",
+         "field 'colour' is unknown: expected one of name, layout, robot, tool, blocks, grid, suction"),
         ("tool.yaw", 90, "field 'tool.yaw' is unknown: did you mean 'tool.yaw_deg'?"),
         ("grid.tower_orgins", [[0, 0, 0]] * 3, "field 'grid.tower_orgins' is unknown: did you mean "
                                                "'grid.tower_origins'?"),
@@ -232,3 +243,19 @@ def test_wrong_types_and_huge_values_name_file_field_value_and_range(dotted: str
 def test_stations_are_frozen(lab_sim: Station) -> None:
     with pytest.raises(AttributeError):
         lab_sim.approach = 0.2  # type: ignore[misc]
+
+
+def test_suction_section_selects_a_profile_or_explicit_levels(lab_sim: Station, lab_real: Station) -> None:
+    """No section: the course simulator's levels; `profile: real`; explicit levels over a profile make `custom`."""
+    assert lab_sim.suction == SIM_LEVELS
+    assert lab_real.suction == REAL  # the shipped real-station example uses the `real` profile
+    assert parse_station(_mutated(LAB_SIM, "suction", {"profile": "real"}), "x.yaml").suction == REAL
+    custom = parse_station(_mutated(LAB_SIM, "suction", {"profile": "real", "ain0_held": 2.6, "digin_held": 3}),
+                           "x.yaml").suction
+    assert (custom.name, custom.ain0_held, custom.digin_held, custom.ain0_free) == ("custom", 2.6, 3, REAL.ain0_free)
+    # A custom profile survives the calibration round trip (calibrate writes it back).
+    again = parse_station(station_to_dict(replace(lab_sim, suction=custom)), "again.yaml")
+    assert again.suction == custom
+    assert with_suction_profile(lab_sim, "real").suction == REAL
+    with pytest.raises(CalibrationError, match="suction profile 'x' is unknown: expected one of lab_sim, real"):
+        with_suction_profile(lab_sim, "x")

@@ -10,6 +10,12 @@ ldconfig -p | grep -q 'libEGL.so.1 ' || missing+=(libegl1)
 ldconfig -p | grep -q 'libEGL_mesa.so.0 ' || missing+=(libegl-mesa0)
 [ -e /usr/lib/x86_64-linux-gnu/dri ] || [ -e /usr/lib/aarch64-linux-gnu/dri ] || missing+=(libgl1-mesa-dri)
 command -v roscore >/dev/null || missing+=(ros-core)
+# ROS 2 interop tests (tests/test_ros2_*.py): a private network namespace (ip from iproute2, unshare) and a C/C++
+# toolchain with cmake to build the course's ur3e_mrc_msgs for the throwaway rclpy environment.
+command -v ip >/dev/null || missing+=(iproute2)
+command -v cmake >/dev/null || missing+=(cmake)
+command -v g++ >/dev/null || missing+=(g++)
+command -v make >/dev/null || missing+=(make)
 for pkg in rospy genpy std_msgs; do
   [ -e "/usr/lib/python3/dist-packages/$pkg/__init__.py" ] || missing+=("python3-${pkg//_/-}")
 done

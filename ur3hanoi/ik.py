@@ -21,6 +21,7 @@ import pinocchio as pin
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import IKError, Ur3HanoiError
 from ur3hanoi.robot import DH_A, DH_D, T_BASELINK_BASE, JointLimits, Ur3Model, dh_fk, dh_link
+from ur3hanoi.robot_registry import DHParameters
 
 Branch = tuple[int, int, int]
 
@@ -44,20 +45,21 @@ def pose_errors(T_actual: pin.SE3, T_target: pin.SE3) -> tuple[float, float]:
 # ------------------------------------------------------------------------------------------------ branches
 
 
-def _p05(q: FloatArray) -> FloatArray:
+def _p05(q: FloatArray, dh: DHParameters | None = None) -> FloatArray:
     """Origin of DH frame 5 (the wrist point used for the shoulder branch) in base [m]."""
-    T06 = dh_fk(q)
-    return T06[:3, 3] - DH_D[5] * T06[:3, 2]
+    T06 = dh_fk(q, dh)
+    return T06[:3, 3] - (DH_D if dh is None else dh.d)[5] * T06[:3, 2]
 
 
-def branch_of(q: FloatArray) -> Branch:
+def branch_of(q: FloatArray, dh: DHParameters | None = None) -> Branch:
     """Configuration branch of ``q`` [rad] as signs (shoulder, elbow, wrist), each +1 or -1.
 
     shoulder: which of the two base angles that put the wrist point in the arm plane ("left/right");
-    elbow: sign of sin(q3) ("up/down"); wrist: sign of sin(q5) ("flip").
+    elbow: sign of sin(q3) ("up/down"); wrist: sign of sin(q5) ("flip"). ``dh``: the robot's DH table (default
+    the UR3's).
     """
     q = np.asarray(q, dtype=float)
-    p = _p05(q)
+    p = _p05(q, dh)
     psi = math.atan2(p[1], p[0])
     shoulder = 1 if float(wrap_angle(q[0] - psi - math.pi / 2)) >= 0.0 else -1
     elbow = 1 if math.sin(q[2]) >= 0.0 else -1
@@ -68,15 +70,18 @@ def branch_of(q: FloatArray) -> Branch:
 BRANCHES: tuple[Branch, ...] = tuple((s, e, w) for s in (1, -1) for e in (1, -1) for w in (1, -1))
 
 
-def analytic_ik(T_base_tool0: FloatArray | pin.SE3, only: Branch | None = None) -> dict[Branch, FloatArray]:
+def analytic_ik(T_base_tool0: FloatArray | pin.SE3, only: Branch | None = None,
+                dh: DHParameters | None = None) -> dict[Branch, FloatArray]:
     """Closed-form UR IK of a flange (``tool0``) pose in ``base``: ``{branch: q}`` for every reachable branch.
 
     Angles are in [-pi, pi). Singular wrist configurations (sin q5 ~ 0) are skipped. ``only`` restricts the
-    solve to one branch (8x cheaper when the branch is known).
+    solve to one branch (8x cheaper when the branch is known). ``dh``: the robot's DH table (default the UR3's);
+    any UR-geometry table works (d2 = d3 = 0, a1 = a4..a6 = 0, the UR alphas).
     """
     T = T_base_tool0.homogeneous if isinstance(T_base_tool0, pin.SE3) else np.asarray(T_base_tool0, dtype=float)
-    d4, d6 = DH_D[3], DH_D[5]
-    a2, a3 = DH_A[1], DH_A[2]
+    D, A = (DH_D, DH_A) if dh is None else (dh.d, dh.a)
+    d4, d6 = D[3], D[5]
+    a2, a3 = A[1], A[2]
     R, p = T[:3, :3], T[:3, 3]
     p05 = p - d6 * R[:, 2]
     r = math.hypot(p05[0], p05[1])
@@ -98,7 +103,7 @@ def analytic_ik(T_base_tool0: FloatArray | pin.SE3, only: Branch | None = None) 
                 continue
             q6 = math.atan2(-float(R[:, 1] @ z1) / sin5, float(R[:, 0] @ z1) / sin5)
             # Planar 3R problem (joints 2-4) in DH frame 1.
-            T14 = _inv_h(dh_link(q1, 0)) @ T @ _inv_h(dh_link(q5, 4) @ dh_link(q6, 5))
+            T14 = _inv_h(dh_link(q1, 0, dh)) @ T @ _inv_h(dh_link(q5, 4, dh) @ dh_link(q6, 5, dh))
             px, py = T14[0, 3], T14[1, 3]
             c3 = (px * px + py * py - a2 * a2 - a3 * a3) / (2 * a2 * a3)
             if abs(c3) > 1.0:
@@ -287,7 +292,7 @@ def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3, q_home: FloatArray, l
     robot = solver.robot
     q_home = np.asarray(q_home, dtype=float)
     if home_branch is None:
-        home_branch = branch_of(q_home)
+        home_branch = branch_of(q_home, robot.dh)
     T_base_tool0 = T_base_tcp * robot.T_tcp_tool0
 
     def where() -> str:
@@ -295,12 +300,13 @@ def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3, q_home: FloatArray, l
         rpy = np.round(np.degrees(pin.rpy.matrixToRpy(T_base_tcp.rotation)), 2).tolist()
         return f"{label}: target xyz {xyz} m rpy {rpy} deg in base"
 
-    branches = analytic_ik(T_base_tool0, only=home_branch)
+    branches = analytic_ik(T_base_tool0, only=home_branch, dh=robot.dh)
     if not branches:
-        reachable = sorted(analytic_ik(T_base_tool0))
+        reachable = sorted(analytic_ik(T_base_tool0, dh=robot.dh))
         if not reachable:
             best = closest_reach(robot, T_base_tcp, q_home)
-            raise IKError(f"{where()} is unreachable by the UR3 (no closed-form solution; closest reach leaves a "
+            raise IKError(f"{where()} is unreachable by the {robot.description.title} (no closed-form solution; "
+                          "closest reach leaves a "
                           f"residual of {best.position_error * 1e3:.1f} mm, {math.degrees(best.orientation_error):.1f}"
                           " deg)")
         raise IKError(f"{where()} has no solution on home's branch {home_branch} (reachable: {reachable})")

@@ -29,13 +29,18 @@ def robot_dir() -> Path:
     return _package_dir("robots", ROBOT_NAME)
 
 
+def robots_dir() -> Path:
+    """The folder of the robot model folders (``universal_robots_ur3``, ``universal_robots_ur3e``)."""
+    return _package_dir("robots")
+
+
 def stations_dir() -> Path:
     """The folder of the shipped station calibrations (and the example taught-points file)."""
     return _package_dir("stations")
 
 
 def station_names() -> tuple[str, ...]:
-    """Names of the shipped stations, sorted (``("lab_real", "lab_sim")``)."""
+    """Names of the shipped stations, sorted (``("lab_real", "lab_sim", "ur3e_sim")``)."""
     return tuple(sorted(p.stem for p in stations_dir().glob("*.yaml") if p.name != TAUGHT_EXAMPLE))
 
 

@@ -27,6 +27,7 @@ import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
+from ur3hanoi.robot_registry import UR3, DHParameters, RobotDescription
 
 JOINT_NAMES: tuple[str, ...] = (
     "shoulder_pan_joint",
@@ -86,6 +87,13 @@ class JointLimits:
     j_max: tuple[float, ...]
 
     @classmethod
+    def for_robot(cls, robot: RobotDescription, elbow_limit: float = 2 * math.pi) -> JointLimits:
+        """``robot``'s limits (:mod:`ur3hanoi.robot_registry`): +-2pi on every joint (``elbow_limit`` [rad] on the
+        elbow), its datasheet speeds and the planner's accelerations and jerks."""
+        base = cls.ur3(elbow_limit)
+        return cls(q_min=base.q_min, q_max=base.q_max, v_max=robot.v_max, a_max=robot.a_max, j_max=robot.j_max)
+
+    @classmethod
     def ur3(cls, elbow_limit: float = 2 * math.pi) -> JointLimits:
         """Datasheet limits; ``elbow_limit`` [rad] optionally restricts the elbow (ROS configs use pi)."""
         if not 0.0 < elbow_limit <= 2 * math.pi:
@@ -135,9 +143,10 @@ def _erd_share_dir() -> Path:
     return Path(str(dist.locate_file("cmeel.prefix/share")))
 
 
-def urdf_path() -> Path:
-    """Path of example-robot-data's ``ur3_robot.urdf`` (loaded by path: some loaders map "ur3" to a UR5)."""
-    path = _erd_share_dir() / "example-robot-data/robots/ur_description/urdf/ur3_robot.urdf"
+def urdf_path(robot: RobotDescription = UR3) -> Path:
+    """Path of example-robot-data's ``ur3_robot.urdf`` (loaded by path: some loaders map "ur3" to a UR5), or of
+    ``robot``'s URDF file there."""
+    path = _erd_share_dir() / f"example-robot-data/robots/ur_description/urdf/{robot.urdf_file}"
     if not path.is_file():
         raise Ur3HanoiError(f"UR3 URDF not found at {path}: example-robot-data >= 4.4 is required")
     return path
@@ -153,12 +162,18 @@ def _fmt(x: float) -> str:
 
 
 @cache
-def urdf_text(tool: ToolOffset | None = None, absolute_meshes: bool = True) -> str:
-    """The UR3 URDF as text, optionally with a ``tcp`` link fixed to ``tool.parent``.
+def urdf_text(tool: ToolOffset | None = None, absolute_meshes: bool = True, robot: RobotDescription = UR3) -> str:
+    """The UR3 URDF (or ``robot``'s) as text, optionally with a ``tcp`` link fixed to ``tool.parent``.
 
     ``absolute_meshes`` rewrites ``package://`` URIs to absolute paths (placo and MuJoCo cannot resolve them).
+    A robot described by DH only (``model_source == "dh"``) gets the URDF :mod:`ur3hanoi.robot_urdf` generates.
     """
-    text = urdf_path().read_text()
+    if robot.model_source == "dh":
+        from ur3hanoi.robot_urdf import urdf_from_dh
+
+        text = urdf_from_dh(robot)
+    else:
+        text = (urdf_path() if robot == UR3 else urdf_path(robot)).read_text()
     if absolute_meshes:
         text = text.replace("package://", str(package_dir()) + "/")
     if tool is not None:
@@ -176,11 +191,13 @@ def urdf_text(tool: ToolOffset | None = None, absolute_meshes: bool = True) -> s
     return text
 
 
-def dh_link(theta: float, i: int) -> FloatArray:
+def dh_link(theta: float, i: int, dh: DHParameters | None = None) -> FloatArray:
     """4x4 DH transform of joint ``i`` (0-based) at angle ``theta`` [rad]: Rz(theta) Tz(d) Tx(a) Rx(alpha).
 
-    Scalar form for the closed-form IK's hot path; :func:`dh_fk` builds the same matrices vectorized.
+    Scalar form for the closed-form IK's hot path; :func:`dh_fk` builds the same matrices vectorized. ``dh``: the
+    robot's table (default the UR3's).
     """
+    DH_D, DH_A, DH_ALPHA = _table(dh)
     ct, st = math.cos(theta), math.sin(theta)
     ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
     return np.array(
@@ -189,12 +206,18 @@ def dh_link(theta: float, i: int) -> FloatArray:
     )
 
 
-def dh_fk(q: FloatArray) -> FloatArray:
-    """UR3 forward kinematics from the DH table: the pose of the flange (``tool0``) in ``base``.
+def _table(dh: DHParameters | None) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+    """(d, a, alpha) of ``dh``, or the UR3's module constants."""
+    return (DH_D, DH_A, DH_ALPHA) if dh is None else (dh.d, dh.a, dh.alpha)
+
+
+def dh_fk(q: FloatArray, dh: DHParameters | None = None) -> FloatArray:
+    """UR3 (or ``dh``'s robot) forward kinematics from the DH table: the pose of the flange (``tool0``) in ``base``.
 
     ``q`` [rad] of shape (6,) gives a 4x4 matrix; shape (N, 6) gives (N, 4, 4) (batched, for checks over whole
     trajectories without a per-sample Pinocchio call).
     """
+    DH_D, DH_A, DH_ALPHA = _table(dh)
     q = np.asarray(q, dtype=float)
     qs = q.reshape(-1, N_JOINTS)
     T = np.broadcast_to(np.eye(4), (len(qs), 4, 4))
@@ -239,20 +262,26 @@ class Ur3Model:
         limits: joint limits to report and enforce (datasheet values by default).
     """
 
-    def __init__(self, tool: ToolOffset | None = None, limits: JointLimits | None = None) -> None:
+    def __init__(self, tool: ToolOffset | None = None, limits: JointLimits | None = None,
+                 robot: RobotDescription = UR3) -> None:
         self.tool = tool if tool is not None else ToolOffset(parent="tool0")
-        self.limits = limits if limits is not None else JointLimits.ur3()
-        self.urdf = urdf_text(self.tool, absolute_meshes=True)
+        self.limits = limits if limits is not None else JointLimits.for_robot(robot)
+        self.description = robot
+        self.dh: DHParameters = robot.dh
+        self.urdf = urdf_text(self.tool, absolute_meshes=True, robot=robot)
         self.model: pin.Model = pin.buildModelFromXML(self.urdf)
         self.data: pin.Data = self.model.createData()
         if tuple(self.model.names[1:]) != JOINT_NAMES:
             raise Ur3HanoiError(f"URDF joints {tuple(self.model.names[1:])} are not the UR3's {JOINT_NAMES}")
         lengths = _link_lengths(self.model)
-        for key, expected in _EXPECTED_LENGTHS.items():
+        d, a = robot.dh.d, robot.dh.a
+        expected_lengths = _EXPECTED_LENGTHS if robot is UR3 else {
+            "d1": d[0], "a2": -a[1], "a3": -a[2], "d4": d[3], "d5": d[4], "d6": d[5]}
+        for key, expected in expected_lengths.items():
             if abs(lengths[key] - expected) > 1e-6:
                 raise Ur3HanoiError(
-                    f"{urdf_path()}: link length {key} = {lengths[key]} m, expected the UR3's {expected} m "
-                    "(is this a UR5/UR10 URDF?)"
+                    f"{robot.urdf_file or robot.name}: link length {key} = {lengths[key]} m, expected the "
+                    f"{robot.title}'s {expected} m (is this a UR5/UR10 URDF?)"
                 )
         self.frame_ids = {name: self.model.getFrameId(name) for name in ("base", "base_link", "tool0", "tcp")}
         self.frame_ids["ee_link"] = self.model.getFrameId("ee_link")
@@ -286,12 +315,14 @@ class Ur3Model:
 
 
 @cache
-def load_ur3(tool: ToolOffset | None = None, limits: JointLimits | None = None) -> Ur3Model:
-    """Cached :class:`Ur3Model` for a tool offset (models are read-only after construction).
+def load_ur3(tool: ToolOffset | None = None, limits: JointLimits | None = None,
+             robot: RobotDescription = UR3) -> Ur3Model:
+    """Cached :class:`Ur3Model` for a tool offset (models are read-only after construction); ``robot`` picks
+    another arm of :mod:`ur3hanoi.robot_registry` (the UR3 by default).
 
     Not thread-safe: each model owns one ``pin.Data`` used by :meth:`Ur3Model.fk`.
     """
-    return Ur3Model(tool, limits)
+    return Ur3Model(tool, limits, robot)
 
 
 __all__ = [

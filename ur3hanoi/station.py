@@ -48,6 +48,17 @@ from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
 from ur3hanoi.resources import station_file, station_names
 from ur3hanoi.robot import FLANGE_FRAMES, N_JOINTS, JointLimits, ToolOffset
+from ur3hanoi.robot_registry import DEFAULT_ROBOT, ROBOTS, RobotDescription
+from ur3hanoi.suction_profile import (
+    AIN_RANGE_V,
+    DEFAULT_PROFILE,
+    DIGIN_MAX,
+    LEVEL_KEYS,
+    MAX_NOISE_V,
+    PROFILES,
+    SuctionProfile,
+    with_levels,
+)
 
 Vec3 = tuple[float, float, float]
 Layout = Literal["flat", "stacked"]
@@ -77,6 +88,9 @@ class Station:
         approach: "above" pose = "on" pose + approach * world z [m].
         source: file the station was read from ("<memory>" if built in code).
         sha256: hex digest of that file's bytes ("" if built in code).
+        suction: what the suction feedback reads (``suction:`` section; the course simulator's levels by
+            default), see :mod:`ur3hanoi.suction_profile`.
+        robot: the arm (``robot.model``; the UR3 by default), see :mod:`ur3hanoi.robot_registry`.
     """
 
     name: str
@@ -95,6 +109,8 @@ class Station:
     approach: float
     source: str = "<memory>"
     sha256: str = ""
+    suction: SuctionProfile = DEFAULT_PROFILE
+    robot: RobotDescription = DEFAULT_ROBOT
 
     @property
     def n_towers(self) -> int:
@@ -155,6 +171,7 @@ STATION_SCHEMA = Record({
     "name": Field(Text(max_len=255), required=False),
     "layout": Field(Choice(LAYOUTS)),
     "robot": Field(Record({
+        "model": Field(Choice(tuple(ROBOTS)), required=False),
         "base_xyz": Field(_POINT),
         **_angles("base_rpy", 3),
         **_angles("home", N_JOINTS),
@@ -179,6 +196,14 @@ STATION_SCHEMA = Record({
         "height_step": Field(_POINT),
         "approach": Field(Number(0.0, 0.5, lo_open=True, unit=_M, what="a length")),
     })),
+    "suction": Field(Record({
+        "profile": Field(Choice(tuple(PROFILES)), required=False),
+        **{key: Field(Number(0, DIGIN_MAX, integer=True), required=False) for key in LEVEL_KEYS
+           if key.startswith("digin")},
+        **{key: Field(Number(*AIN_RANGE_V, unit="V", what="a voltage"), required=False) for key in LEVEL_KEYS
+           if key.startswith("ain0") and key != "ain0_noise"},
+        "ain0_noise": Field(Number(0.0, MAX_NOISE_V, unit="V", what="a standard deviation"), required=False),
+    }), required=False),
 })
 """The calibration file's schema: every key, its type and range (see ``ur3hanoi/stations/README.md``)."""
 
@@ -231,7 +256,8 @@ def parse_station(data: Any, source: str = "<memory>") -> Station:
 
     base_rpy = _angles_rad(source, robot, "robot", "base_rpy", 3, default=(0.0, 0.0, 0.0))
     elbow = math.radians(float(robot.get("elbow_limit_deg", 360.0)))
-    limits = JointLimits.ur3(elbow_limit=elbow)
+    arm = ROBOTS[robot.get("model", DEFAULT_ROBOT.name)]
+    limits = JointLimits.for_robot(arm, elbow_limit=elbow)
     q_home = _angles_rad(source, robot, "robot", "home", N_JOINTS)
     tool_rpy = _angles_rad(source, tool, "tool", "rpy", 3)
     tool_offset = ToolOffset(parent=tool["parent"], xyz=_vec3(tool["xyz"]), rpy=_vec3(tool_rpy))
@@ -264,14 +290,36 @@ def parse_station(data: Any, source: str = "<memory>") -> Station:
         step = np.array(grid["tower_step"], dtype=float)
         origins = tuple(_vec3(origin + t * step) for t in range(n_towers))
 
+    suction = parse_suction(data.get("suction"))
     station = Station(
         name=name, layout=layout, base_xyz=_vec3(robot["base_xyz"]), base_rpy=_vec3(base_rpy), q_home=q_home,
         limits=limits, tool=tool_offset, tool_yaw=tool_yaw, block_size=block_size, contact_depth=depth,
         tower_origins=origins, height_step=_vec3(grid["height_step"]), n_heights=n_heights,
-        approach=float(grid["approach"]), source=source,
+        approach=float(grid["approach"]), source=source, suction=suction, robot=arm,
     )
     validate(station)
     return station
+
+
+def with_suction_profile(station: Station, name: str) -> Station:
+    """``station`` with the named suction profile (``lab_sim``, ``real``) instead of its calibration's.
+
+    Raises:
+        CalibrationError: ``name`` is not a profile.
+    """
+    if name not in PROFILES:
+        raise CalibrationError(f"suction profile {printable(name, 60)!r} is unknown: expected one of "
+                               f"{', '.join(PROFILES)}")
+    return replace(station, suction=PROFILES[name])
+
+
+def parse_suction(section: Mapping[str, Any] | None) -> SuctionProfile:
+    """The suction profile of a (schema-checked) ``suction`` section: a named profile (default ``lab_sim``)
+    with any explicitly given levels replacing its own (the result is then named ``custom``)."""
+    if section is None:
+        return DEFAULT_PROFILE
+    base = PROFILES[section["profile"]] if "profile" in section else DEFAULT_PROFILE
+    return with_levels(base, {k: v for k, v in section.items() if k != "profile"})
 
 
 def validate(s: Station) -> None:
@@ -280,7 +328,8 @@ def validate(s: Station) -> None:
     src = s.source
     if not s.limits.within_position(s.q_home_array):
         raise fail(src, "robot.home_deg", [round(math.degrees(v), 6) for v in s.q_home],
-                   "joint angles within the UR3 limits (+-360 deg; elbow within robot.elbow_limit_deg)")
+                   f"joint angles within the {s.robot.name.upper()} limits (+-360 deg; elbow within "
+                   "robot.elbow_limit_deg)")
     step = np.array(s.height_step)
     horiz, vert = float(np.linalg.norm(step[:2])), float(step[2])
     if s.n_heights > 1 or np.linalg.norm(step) > 0:
@@ -314,6 +363,7 @@ def station_to_dict(s: Station) -> dict[str, Any]:
         "name": s.name,
         "layout": s.layout,
         "robot": {
+            **({} if s.robot == DEFAULT_ROBOT else {"model": s.robot.name}),
             "base_xyz": rnd(s.base_xyz),
             "base_rpy_deg": deg(s.base_rpy),
             "home_deg": deg(s.q_home),
@@ -333,4 +383,12 @@ def station_to_dict(s: Station) -> dict[str, Any]:
             "height_step": rnd(s.height_step),
             "approach": round(s.approach, 12),
         },
+        "suction": _suction_to_dict(s.suction),
     }
+
+
+def _suction_to_dict(p: SuctionProfile) -> dict[str, Any]:
+    """A named profile by its name; a custom one as every level over the default profile."""
+    if PROFILES.get(p.name) == p:
+        return {"profile": p.name}
+    return {k: v for k, v in p.as_dict().items() if k != "profile"}

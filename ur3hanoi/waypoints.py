@@ -54,10 +54,10 @@ def generate_table(station: Station, solver: str | IKSolver = "pinocchio") -> Ta
         IKError: a pose is unreachable or out of limits; the message names tower, height and on/above.
     """
     if isinstance(solver, str):
-        solver = make_solver(solver, load_ur3(station.tool, station.limits))
+        solver = make_solver(solver, load_ur3(station.tool, station.limits, station.robot))
     q = np.empty((station.n_towers, station.n_heights, 2, N_JOINTS))
     results = []
-    home_branch = branch_of(station.q_home_array)
+    home_branch = branch_of(station.q_home_array, station.robot.dh)
     for t in range(station.n_towers):
         for h in range(station.n_heights):
             for k in (0, 1):
@@ -96,7 +96,7 @@ def check_table(q: FloatArray, station: Station, tol_mm: float = 1.0, tol_deg: f
             f"{printable(station.source)} "
             f"has {station.n_towers} x {station.n_heights}"
         )
-    robot = load_ur3(station.tool, station.limits)
+    robot = load_ur3(station.tool, station.limits, station.robot)
     T_wb = station.T_world_base
     rows = []
     for t in range(q.shape[0]):

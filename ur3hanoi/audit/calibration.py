@@ -76,7 +76,8 @@ def check_against(table: RecordedTable, station: Station, tol_mm: float = STRICT
     grid_points = {s: T_world_tcp(station, *s).translation for s in slots}
     fields = [f"{table.key}[{t}][{h}][{k}]" for t, h, k in present]
     labels = [f"{fields[i]} ({pose_label(*s)})" for i, s in enumerate(present)]
-    what = diagnose(load_ur3(station.tool, station.limits), station.T_world_base, present, qs, m.p_world, rot,
+    robot = load_ur3(station.tool, station.limits, station.robot)
+    what = diagnose(robot, station.T_world_base, present, qs, m.p_world, rot,
                     targets, grid_points, order, station.tool_yaw, tol_mm, tol_deg, labels)
     src = printable(station.source)
     suspects = tuple(

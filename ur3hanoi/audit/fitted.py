@@ -237,7 +237,8 @@ def _contact_reasons(table: RecordedTable, base: Station, slots: list[Slot], qs:
     grid_points = {(t, h, ON): fit.solution.point((t, h, ON)) for t in range(table.n_towers)
                    for h in range(table.n_heights)}
     labels = [f"{pose_label(*s)} ({field[s]})" for s in c_slots]
-    what = diagnose_contacts(load_ur3(base.tool, base.limits), base.T_world_base, c_slots, [qs[i] for i in c_idx],
+    robot = load_ur3(base.tool, base.limits, base.robot)
+    what = diagnose_contacts(robot, base.T_world_base, c_slots, [qs[i] for i in c_idx],
                              p_world[c_idx], tilt[c_idx], targets, grid_points, flagged, axis, rule.flag_mm,
                              rule.flag_deg, CONTACT_OK_MM, TILT_OK_DEG, labels)
     out: dict[Slot, str] = {}

@@ -288,7 +288,8 @@ def _reasons(ctx: _Context, suspects: Sequence[int]) -> dict[int, str]:
     gridded = [i for i in range(len(pts)) if not np.isnan(ctx.fitted[i]).any() and not ctx.shared[i]]
     slots = [(p.tower, p.height, p.k) for p in pts]
     where = {g: n for n, g in enumerate(gridded)}
-    what = diagnose(load_ur3(ctx.base.tool, ctx.base.limits), ctx.base.T_world_base, [slots[i] for i in gridded],
+    robot = load_ur3(ctx.base.tool, ctx.base.limits, ctx.base.robot)
+    what = diagnose(robot, ctx.base.T_world_base, [slots[i] for i in gridded],
                     [pts[i].q for i in gridded], m.p_world[gridded], ctx.fit.rot_deg[gridded], ctx.fitted[gridded],
                     ctx.grid_points,
                     [where[i] for i in suspects if i in where], ctx.fit.yaw, th.mm, th.deg,

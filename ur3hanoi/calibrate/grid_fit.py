@@ -56,7 +56,7 @@ class Measured:
 
 def measure(station: Station, qs: Sequence[Sequence[float]]) -> Measured:
     """FK of joint poses ``qs`` [rad] with ``station``'s robot base and tool."""
-    robot = load_ur3(station.tool, station.limits)
+    robot = load_ur3(station.tool, station.limits, station.robot)
     T_wb = station.T_world_base
     n = len(qs)
     p, R = np.empty((n, 3)), np.empty((n, 3, 3))

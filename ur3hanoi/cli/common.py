@@ -40,3 +40,13 @@ def check_render_outputs(video: str | None, frames: str | None, inputs: Sequence
 def shown(path: Any) -> str:
     """A user-given path as printed on the terminal (control characters escaped)."""
     return printable(path, 4096)
+
+
+def add_suction_profile_option(p: Any) -> None:
+    """``--suction-profile NAME``: a named suction feedback profile instead of the calibration's ``suction``."""
+    from ur3hanoi.suction_profile import PROFILES
+
+    p.add_argument("--suction-profile", choices=list(PROFILES), default=None,
+                   help="suction feedback levels (DIGIN/AIN0 held, cup free, off): lab_sim = the course simulator's "
+                        "(~1.9/1.45/1.05 V), real = a real station's (2.35/1.40/1.05 V); default: the "
+                        "calibration's suction section (lab_sim without one)")

@@ -15,10 +15,10 @@ from collections.abc import Sequence
 from typing import NoReturn
 
 from ur3hanoi import __version__
-from ur3hanoi.cli import calibrate, check_table, exit_codes, plan, ros, solve, tables
+from ur3hanoi.cli import calibrate, check_table, exit_codes, plan, ros, ros2, solve, tables
 from ur3hanoi.errors import Ur3HanoiError, printable
 
-_COMMANDS = (tables, check_table, calibrate, plan, solve, ros)
+_COMMANDS = (tables, check_table, calibrate, plan, solve, ros, ros2)
 _DEBUG_HELP = "on an internal error, show the Python traceback (for a bug report)"
 
 

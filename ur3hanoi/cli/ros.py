@@ -14,7 +14,7 @@ import os
 import sys
 from pathlib import Path
 
-from ur3hanoi.cli.common import DEFAULT_CALIBRATION
+from ur3hanoi.cli.common import DEFAULT_CALIBRATION, add_suction_profile_option
 from ur3hanoi.cli.options import (
     BLOCKS,
     CMD_ACCELERATION,
@@ -78,6 +78,7 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
                    help="address the station and the roscore it starts listen on and advertise (ROS_IP); default "
                         "127.0.0.1: this machine only. Give this machine's lab-network address to open them to "
                         "other machines (a master on another machine needs it)")
+    add_suction_profile_option(p)
     out = p.add_mutually_exclusive_group()
     out.add_argument("--video", metavar="FILE.mp4", help="render an MP4 offscreen (headless: MUJOCO_GL=egl)")
     out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR")
@@ -102,7 +103,8 @@ def _run_station(args: argparse.Namespace) -> int:
         drop_on_grasp=None if args.drop_on_grasp is None else args.drop_on_grasp - 1, seed=args.seed,
         rate_hz=args.rate, report=report_file,
         frames=Path(args.frames) if args.frames else None, video=Path(args.video) if args.video else None,
-        duration_s=args.duration, master_uri=args.master, host=args.host)
+        duration_s=args.duration, master_uri=args.master, host=args.host,
+        suction_profile=args.suction_profile)
     node = RosStation(options)
     # Standard output carries only the JSON report: whatever else writes to file descriptor 1 (rospy's info
     # handler, C libraries) goes to stderr while the node runs.

@@ -20,7 +20,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ur3hanoi.cli import exit_codes
-from ur3hanoi.cli.common import DEFAULT_CALIBRATION, calibration_ref, check_render_outputs, input_file, shown
+from ur3hanoi.cli.common import (
+    DEFAULT_CALIBRATION,
+    add_suction_profile_option,
+    calibration_ref,
+    check_render_outputs,
+    input_file,
+    shown,
+)
 from ur3hanoi.cli.options import (
     BLOCKS,
     FPS,
@@ -98,6 +105,7 @@ def add(sub: argparse._SubParsersAction) -> None:
                         "default when rendering)")
     p.add_argument("--view", action="store_true", help="open MuJoCo's interactive viewer (needs a display)")
     p.add_argument("--json", action="store_true", help="print one JSON object with the outcome on stdout")
+    add_suction_profile_option(p)
     p.set_defaults(func=run)
 
 
@@ -207,6 +215,10 @@ def run(args: argparse.Namespace) -> int:
     cal = _table_calibration(args)
     inputs = [input_file(cal)]
     station = load_station(cal)
+    if args.suction_profile is not None:
+        from ur3hanoi.station import with_suction_profile
+
+        station = with_suction_profile(station, args.suction_profile)
     table = recorded = None
     if args.table is not None:
         from ur3hanoi.labfile import read_recorded_table
@@ -290,13 +302,15 @@ def run(args: argparse.Namespace) -> int:
 
     if args.json:
         out = result.as_dict()
+        out["suction"] = station.suction.as_dict()
         if args.table is not None:
             out["table"] = {"file": str(args.table), "key": args.key}
         print(json.dumps(out))
     else:
         following = f", following {shown(args.table)}:{args.key}" if args.table is not None else ""
         print(f"{result.status}: {result.moves_completed}/{result.moves_total} moves, tower {start + 1} -> "
-              f"{end + 1}, {len(result.final_blocks)} blocks on {shown(station.name)}{following}")
+              f"{end + 1}, {len(result.final_blocks)} blocks on {shown(station.name)}{following} (suction profile "
+              f"{station.suction.name})")
         for b in result.final_blocks:
             where = "in no slot"
             if b.tower is not None and b.height is not None:

@@ -18,6 +18,9 @@ def add(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", required=True, metavar="FILE",
                    help=f"lab-format YAML file to create/update ({SYMLINK_NOTE}; concurrent runs are serialized)")
     p.add_argument("--solver", default="pinocchio", choices=["pinocchio", "placo"], help="IK solver")
+    p.add_argument("--convention", default="controller", choices=["controller", "course"],
+                   help="joint convention of the written angles: controller (the pendant's, default) or course (the "
+                        "ROS 2 course bridge's: controller - [pi/2, 0, 0, -pi/2, 0, 0]); named in the key's header")
     p.set_defaults(func=run)
 
 
@@ -33,7 +36,8 @@ def run(args: argparse.Namespace) -> int:
         read_lab_file(args.output)  # not YAML, or its top level is not a mapping: refused before the IK too
     station = load_station(args.calibration)
     table = generate_table(station, args.solver)
-    write_table(args.output, table, args.key, calibration_label=Path(args.calibration).as_posix(), inputs=inputs)
+    write_table(args.output, table, args.key, calibration_label=Path(args.calibration).as_posix(), inputs=inputs,
+                convention=args.convention)
     print(
         f"wrote {args.key} ({station.n_towers} towers x {station.n_heights} heights x 2) to {shown(args.output)}: "
         f"max IK error {table.max_position_error:.2e} m, {table.max_orientation_error:.2e} rad ({args.solver})"

@@ -276,15 +276,20 @@ def splice_yaml(old_text: str, new_sections: Mapping[str, str], header_lines: Ma
     return "".join(out)
 
 
-def _provenance(key: str, table: Table, label: str, with_solver: bool) -> str:
+def _provenance(key: str, table: Table, label: str, with_solver: bool, convention: str = "controller") -> str:
+    from ur3hanoi.convention import DESCRIPTION
+    from ur3hanoi.robot_registry import DEFAULT_ROBOT
+
     st = table.station
     # The label is a path given by the user: never let it break the comment line (newlines, control characters).
     what = f"sha256 {st.sha256 or 'n/a'}" + (f", {table.solver} IK" if with_solver else "")
+    if with_solver and (st.robot != DEFAULT_ROBOT or convention != "controller"):
+        what += f", {st.robot.title}, {DESCRIPTION[convention]}"
     return f"# ur3hanoi {__version__}: {key} generated from {printable(label, 4096)} ({what})"
 
 
 def write_table(path: str | Path, table: Table, key: str, calibration_label: str | None = None,
-                inputs: Sequence[str | Path] = ()) -> str:
+                inputs: Sequence[str | Path] = (), convention: str = "controller") -> str:
     """Write ``table`` under ``key`` into ``path`` (created or updated in place; see the module docstring).
 
     Args:
@@ -293,6 +298,8 @@ def write_table(path: str | Path, table: Table, key: str, calibration_label: str
         key: ``sim_pos`` or ``real_pos``.
         calibration_label: how the calibration is named in the provenance comment (default: its source).
         inputs: files the output must not be (the station's own file is always one).
+        convention: joint convention of the written values (:mod:`ur3hanoi.convention`; ``table.q`` is in the
+            controller's); any other than ``controller`` is named in the key's provenance line.
 
     Returns:
         The text written.
@@ -303,12 +310,18 @@ def write_table(path: str | Path, table: Table, key: str, calibration_label: str
         OutputError: ``path`` cannot be written (an input file, a directory, a device, no space...).
         In both cases the file is left byte-identical.
     """
+    from dataclasses import replace
+
+    from ur3hanoi.convention import from_controller
+
     check_key(key)
     st = table.station
     label = calibration_label or st.source
+    if convention != "controller":
+        table = replace(table, q=from_controller(table.q, convention))
     sections = {key: format_q(table.q, key)}
     values: dict[str, Any] = {key: table.q}
-    headers = {key: _provenance(key, table, label, with_solver=True)}
+    headers = {key: _provenance(key, table, label, with_solver=True, convention=convention)}
     if st.layout == "flat":
         xy = block_xy_pos(st)
         sections[BLOCK_XY_KEY] = format_xy(xy)

@@ -9,14 +9,14 @@ from functools import lru_cache
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.robot import DH_A, DH_D, load_ur3
+from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import Station
 
 
 @lru_cache(maxsize=32)
 def _tcp_frames(station: Station) -> tuple[tuple[float, float, float], FloatArray, FloatArray]:
     """The suction point in the flange frame (tool0) [m], and the world rotation and translation of ``base``."""
-    t = load_ur3(station.tool, station.limits).T_flange_tcp("tool0").translation
+    t = load_ur3(station.tool, station.limits, station.robot).T_flange_tcp("tool0").translation
     T_wb = station.T_world_base
     return (float(t[0]), float(t[1]), float(t[2])), T_wb.rotation.copy(), T_wb.translation.copy()
 
@@ -31,8 +31,8 @@ def tcp_positions_world(station: Station, q: FloatArray) -> FloatArray:
     """
     q = np.asarray(q, dtype=float).reshape(-1, 6)
     (tx, ty, tz), R_wb, p_wb = _tcp_frames(station)
-    d1, _, _, d4, d5, d6 = DH_D
-    a2, a3 = DH_A[1], DH_A[2]
+    d1, _, _, d4, d5, d6 = station.robot.dh.d
+    a2, a3 = station.robot.dh.a[1], station.robot.dh.a[2]
     c1, s1 = np.cos(q[:, 0]), np.sin(q[:, 0])
     q23 = q[:, 1] + q[:, 2]
     q234 = q23 + q[:, 3]

@@ -41,7 +41,7 @@ def build_waypoints(station: Station, node_step_m: float = 0.002) -> Waypoints:
 @lru_cache(maxsize=32)
 def _build_waypoints(station: Station, node_step_m: float) -> Waypoints:
     table = generate_table(station)
-    robot = load_ur3(station.tool, station.limits)
+    robot = load_ur3(station.tool, station.limits, station.robot)
     n = max(2, math.ceil(station.approach / node_step_m)) + 1
     s_nodes = np.linspace(0.0, station.approach, n)
     vertical = tuple(tuple(vertical_path(robot, station, table.q, t, h, s_nodes) for h in range(station.n_heights))

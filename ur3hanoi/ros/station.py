@@ -87,6 +87,8 @@ class StationOptions:
         master_uri: ROS master (None: ``ROS_MASTER_URI``, else http://localhost:11311).
         host: address the station and the roscore it starts listen on and advertise (``ROS_IP``); the default
             127.0.0.1 keeps them on this machine.
+        suction_profile: a named suction feedback profile (``lab_sim``, ``real``) replacing the calibration's,
+            or None (the calibration's ``suction`` section).
     """
 
     calibration: str = "lab_sim"
@@ -102,6 +104,7 @@ class StationOptions:
     duration_s: float | None = None
     master_uri: str | None = None
     host: str = "127.0.0.1"
+    suction_profile: str | None = None
 
 
 LAG_BINS_MS: tuple[float, ...] = (1.0, 2.0, 4.0, 8.0, 16.0, 32.0)
@@ -163,6 +166,10 @@ class RosStation:
         self.out = out if out is not None else (lambda s: print(s, file=sys.stderr, flush=True))
         self.report_out = report_out if report_out is not None else (lambda s: print(s, flush=True))
         self.station = load_station(opts.calibration)
+        if opts.suction_profile is not None:
+            from ur3hanoi.station import with_suction_profile
+
+            self.station = with_suction_profile(self.station, opts.suction_profile)
         n_blocks = self.station.n_heights if opts.n_blocks is None else opts.n_blocks
         if not 1 <= n_blocks <= self.station.n_heights:
             raise RosError(f"{n_blocks} blocks is invalid: expected 1..{self.station.n_heights} (the grid's heights)")
@@ -279,6 +286,7 @@ class RosStation:
         holding = w.holding
         return {
             "station": {"name": st.name, "calibration": st.source, "sha256": st.sha256},
+            "suction": w.cup.profile.as_dict(),
             "master_uri": self.master_uri,
             "roscore_started": self.roscore_started,
             "blocks": w.n_blocks,
@@ -383,7 +391,7 @@ class RosStation:
         next_frame = 0.0
         st = self.station
         self.out(f"{READY_LINE} on {self.master_uri}: {st.name}, {w.n_blocks} blocks on tower {opts.start + 1}, "
-                 f"{1.0 / period:g} Hz (pid {os.getpid()})")
+                 f"{1.0 / period:g} Hz, suction profile {w.cup.profile.name} (pid {os.getpid()})")
         # Everything built so far lives as long as the node: keep the cyclic collector from scanning it in the loop.
         gc.collect()
         gc.freeze()

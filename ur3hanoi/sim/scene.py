@@ -109,9 +109,14 @@ def build_task_spec(station: Station, start: int, n_blocks: int, removed: int | 
     The ``suction`` site is moved to the station's tool offset, so it is the calibration's TCP exactly.
     """
     cfg = config if config is not None else SceneConfig()
-    if not SCENE_XML.is_file():
+    if station.robot.model_source == "dh":
+        from ur3hanoi.sim.dh_model import build_dh_robot_spec
+
+        spec = build_dh_robot_spec(station.robot)  # e.g. the UR3e: built from its description
+    elif not SCENE_XML.is_file():
         raise SimulationError(f"{SCENE_XML} is missing: run python -m ur3hanoi.sim")
-    spec = mujoco.MjSpec.from_file(str(SCENE_XML))
+    else:
+        spec = mujoco.MjSpec.from_file(str(SCENE_XML))
     spec.option.timestep = cfg.timestep
     spec.option.noslip_iterations = cfg.noslip_iterations
     if cfg.timestep > 0.002 + 1e-12:

@@ -3,7 +3,9 @@
 :class:`SuctionCup` follows the course's Gazebo plugin rule adapted to a weld: when the suction is on and the
 suction point is within ``grasp_radius`` of where it would be at contact with a block, that block's weld equality
 (added by :func:`ur3hanoi.sim.build_task_spec`) is activated at the current relative pose. :class:`GripperInput`
-is the emulated ``ur3/gripper_input`` sample (``DIGIN`` bit 0 = block held, ``AIN0`` [V], seeded noise).
+is the emulated ``ur3/gripper_input`` sample (``DIGIN`` bit 0 = block held, ``AIN0`` [V], seeded noise), at the
+levels of a :class:`~ur3hanoi.suction_profile.SuctionProfile`: the station calibration's (``suction:`` section;
+the course simulator's levels by default) unless :class:`SuctionConfig` gives one.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.sim.scene import TaskScene
+from ur3hanoi.suction_profile import SuctionProfile
 
 
 @dataclass(frozen=True)
@@ -30,17 +33,15 @@ class SuctionConfig:
             distance of the block's centre from where the weld holds it (its pose in the cup when grasped). A
             block grasped off-centre (anywhere within ``grasp_radius``) is held as firmly as a centred one; only a
             weld stretched further means the block is being torn off.
-        ain_holding, ain_on_empty, ain_off: ``AIN0`` [V] holding a block, suction on with nothing held, suction
-            off (the course simulator's values).
-        ain_noise: standard deviation [V] of the seeded Gaussian noise on ``AIN0``.
+        profile: the feedback levels (``DIGIN``, ``AIN0`` held / cup free / off); None: the station's
+            (``Station.suction``, from the calibration's ``suction`` section).
+        ain_noise: standard deviation [V] of the seeded Gaussian noise on ``AIN0``; None: the profile's.
     """
 
     grasp_radius: float = 0.01
     hold_tolerance: float = 0.01
-    ain_holding: float = 1.9
-    ain_on_empty: float = 1.45
-    ain_off: float = 1.05
-    ain_noise: float = 0.01
+    profile: SuctionProfile | None = None
+    ain_noise: float | None = None
 
 
 @dataclass(frozen=True)
@@ -62,6 +63,9 @@ class SuctionCup:
     def __init__(self, scene: TaskScene, config: SuctionConfig | None = None, seed: int = 0) -> None:
         self.scene = scene
         self.config = config if config is not None else SuctionConfig()
+        profile = self.config.profile if self.config.profile is not None else scene.station.suction
+        self.profile: SuctionProfile = profile
+        self._noise = profile.ain0_noise if self.config.ain_noise is None else self.config.ain_noise
         self.rng = np.random.default_rng(seed)
         self.on = False
         self.attached: int | None = None
@@ -142,9 +146,7 @@ class SuctionCup:
         return self.stretch() <= self.config.hold_tolerance
 
     def feedback(self) -> GripperInput:
-        """The emulated ``gripper_input`` now (seeded noise on ``AIN0``)."""
-        c = self.config
-        held = self.held()
-        volts = c.ain_holding if held else (c.ain_on_empty if self.on else c.ain_off)
-        volts += float(self.rng.normal(0.0, c.ain_noise)) if c.ain_noise > 0 else 0.0
-        return GripperInput(t=float(self.scene.data.time), digin=int(held), ain0=volts)
+        """The emulated ``gripper_input`` now, at the profile's levels (seeded noise on ``AIN0``)."""
+        digin, volts = self.profile.levels(self.held(), self.on)
+        volts += float(self.rng.normal(0.0, self._noise)) if self._noise > 0 else 0.0
+        return GripperInput(t=float(self.scene.data.time), digin=digin, ain0=volts)

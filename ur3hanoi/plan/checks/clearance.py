@@ -36,7 +36,7 @@ from ur3hanoi.plan.checks.collision import MAX_REPORTED, CollisionScene, clearan
 from ur3hanoi.plan.motion.sampling import evaluate
 from ur3hanoi.plan.types import KinematicLimits, Phase, PlanConfig, Segment
 from ur3hanoi.plan.waypoints import geometry_key
-from ur3hanoi.robot import DH_A, DH_ALPHA, DH_D, N_JOINTS, T_BASELINK_BASE, dh_link
+from ur3hanoi.robot import N_JOINTS, T_BASELINK_BASE, dh_link
 from ur3hanoi.station import Station
 
 Slot = tuple[int, int]
@@ -103,7 +103,7 @@ class _Scene:
         T = T_BASELINK_BASE.homogeneous
         self.dh_to_joint = []
         for i in range(N_JOINTS):
-            T = T @ dh_link(0.0, i)
+            T = T @ dh_link(0.0, i, station.robot.dh)
             self.dh_to_joint.append(np.linalg.inv(T) @ self.data.oMi[i + 1].homogeneous)
         self.gd = pin.GeometryData(gm)
         for req in self.gd.distanceRequests:  # explicit: never warm-start GJK from a previous query
@@ -116,6 +116,8 @@ class _Scene:
         out = np.empty((S, self.model.njoints, 4, 4))
         out[:, 0] = np.eye(4)
         T = np.broadcast_to(T_BASELINK_BASE.homogeneous, (S, 4, 4))
+        dh = self.station.robot.dh
+        DH_D, DH_A, DH_ALPHA = dh.d, dh.a, dh.alpha
         for i in range(N_JOINTS):
             ct, st = np.cos(q[:, i]), np.sin(q[:, i])
             ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])

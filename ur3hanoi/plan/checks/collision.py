@@ -66,7 +66,7 @@ class CollisionScene:
         import coal
 
         self.station = station
-        robot = load_ur3(station.tool, station.limits)
+        robot = load_ur3(station.tool, station.limits, station.robot)
         self.robot = robot
         self.model = robot.model
         self.data = self.model.createData()

@@ -94,11 +94,11 @@ def line_ik(robot: Ur3Model, station: Station, tower: int, height: int) -> Calla
     on home's branch, nearest ``q_ref``."""
     T_above = T_base_tcp(station, tower, height, ABOVE)
     R_base_world = station.T_world_base.rotation.T
-    branch = branch_of(station.q_home_array)
+    branch = branch_of(station.q_home_array, robot.dh)
 
     def ik(s: float, q_ref: FloatArray) -> FloatArray:
         T = pin.SE3(T_above.rotation, T_above.translation - R_base_world @ np.array([0.0, 0.0, s]))
-        sols = analytic_ik(T * robot.T_tcp_tool0, only=branch)
+        sols = analytic_ik(T * robot.T_tcp_tool0, only=branch, dh=robot.dh)
         q = nearest_equivalent(sols[branch], q_ref, station.limits) if branch in sols else None
         if q is None:
             raise PlanError(f"tower {tower + 1} height {height + 1}: the vertical line {s * 1e3:.1f} mm below the "

@@ -122,7 +122,8 @@ class StationPlanner:
         above pose), tool down, on home's branch: where a motion rises to clear taller towers."""
         key = (slot, z)
         if key not in self._over:
-            ik = line_ik(load_ur3(self.station.tool, self.station.limits), self.station, *slot)
+            st = self.station
+            ik = line_ik(load_ur3(st.tool, st.limits, st.robot), st, *slot)
             try:
                 self._over[key] = ik(self.z_above(slot) - z, self.q_above(slot))
             except PlanError as e:
@@ -225,7 +226,7 @@ class StationPlanner:
     def _lateral(self, slot: Slot, d_world: FloatArray) -> FloatArray:
         """Joint velocity [rad/s] moving the suction point at the slot's above pose horizontally at 1 m/s along
         ``d_world``."""
-        robot = load_ur3(self.station.tool, self.station.limits)
+        robot = load_ur3(self.station.tool, self.station.limits, self.station.robot)
         q = self.q_above(slot)
         R_world_tcp = self.station.T_world_base.rotation @ robot.fk(q, "tcp").rotation
         return lateral_direction(robot.frame_jacobian_local(q, "tcp"), R_world_tcp, d_world)

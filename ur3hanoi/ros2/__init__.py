@@ -1,0 +1,11 @@
+"""The ROS 2 course interface (UMD ENME480 ``ur3e_mrc_msgs``) without a ROS installation, on Cyclone DDS.
+
+- :mod:`~ur3hanoi.ros2.msgs`: the messages as DDS IDL types, their ``.msg`` text and RIHS01 type hashes.
+- :mod:`~ur3hanoi.ros2.dds`: a ROS 2 node made of one Cyclone DDS participant (loopback-only by default, ROS 2's
+  default QoS, type hashes in USER_DATA, the node announced on ``ros_discovery_info``).
+- :mod:`~ur3hanoi.ros2.station`: ``ros2-station``, the MuJoCo station as the course bridge.
+- :mod:`~ur3hanoi.ros2.client`: ``ros2-solve``'s arm, driven by :func:`ur3hanoi.ros.solve.run_lab_solve`.
+
+The world, command checks, motion and suction logic are the ROS 1 station's (middleware-free modules of
+:mod:`ur3hanoi.ros`); only the transport differs.
+"""
