@@ -8,10 +8,9 @@ import sys
 from pathlib import Path
 
 from ur3hanoi.cli.common import SYMLINK_NOTE, input_file, shown
-from ur3hanoi.cli.options import UsageError
+from ur3hanoi.cli.options import TABLE_KEYS, UsageError
 from ur3hanoi.errors import printable, quote
 from ur3hanoi.io.schema import Text
-from ur3hanoi.labfile import TABLE_KEYS
 
 _NAME = Text(max_len=255)
 

@@ -7,8 +7,7 @@ import argparse
 import json
 
 from ur3hanoi.cli import exit_codes
-from ur3hanoi.cli.options import TOL_DEG, TOL_MM, UsageError, option
-from ur3hanoi.labfile import TABLE_KEYS
+from ur3hanoi.cli.options import TABLE_KEYS, TOL_DEG, TOL_MM, UsageError, option
 
 
 def add(sub: argparse._SubParsersAction) -> None:

@@ -29,6 +29,7 @@ from ur3hanoi.cli.options import (
     SEED,
     SIM_TIME,
     SPEED,
+    TABLE_KEYS,
     TOWER,
     UsageError,
     check_blocks,
@@ -39,7 +40,6 @@ from ur3hanoi.cli.options import (
     option,
 )
 from ur3hanoi.errors import OutputError, SuctionFaultError, Ur3HanoiError, printable
-from ur3hanoi.labfile import TABLE_KEYS
 
 if TYPE_CHECKING:
     from ur3hanoi.sim import ProgressFn

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ur3hanoi.cli.common import SYMLINK_NOTE, input_file, shown
-from ur3hanoi.labfile import TABLE_KEYS
+from ur3hanoi.cli.options import TABLE_KEYS
 
 
 def add(sub: argparse._SubParsersAction) -> None:
