@@ -206,8 +206,9 @@ def _add_env(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_env(args: argparse.Namespace) -> int:
-    from ur3hanoi.ros.env import default_cache_dir, env_lines, write_client_env
+    from ur3hanoi.ros.env import default_cache_dir, env_lines
     from ur3hanoi.ros.master import MasterUri, master_uri_from_env
+    from ur3hanoi.ros.msgs import write_client_env
 
     folder = Path(args.dir).resolve() if args.dir else default_cache_dir()
     uri = args.master or master_uri_from_env()

@@ -248,6 +248,7 @@ def run(args: argparse.Namespace) -> int:
         Faults,
         OffscreenRecorder,
         SimConfig,
+        SimResult,
         ViewerSink,
         build_task_scene,
         display_available,
@@ -288,7 +289,7 @@ def run(args: argparse.Namespace) -> int:
                               scene=scene, realtime=args.view)
         except SuctionFaultError as exc:
             # A halted run still has a result to report (the final block positions, the halt).
-            if exc.result is None:
+            if not isinstance(exc.result, SimResult):
                 raise
             result, fault = exc.result, exc
     finally:
