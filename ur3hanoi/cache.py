@@ -74,7 +74,7 @@ def load(kind: str, key: str) -> bytes | None:
             head = f.readline(4096)
             body = f.read()
         header = json.loads(head)
-        payload = base64.b64decode(body, validate=True)
+        payload = base64.b64decode(body.rstrip(b"\n"), validate=True)
     except (OSError, ValueError, binascii.Error):  # json and base64 errors are ValueErrors
         return None
     if header != _header(kind, key, payload):
