@@ -23,7 +23,7 @@ import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import IKError, Ur3HanoiError
-from ur3hanoi.robot import DH_A, DH_D, T_BASELINK_BASE, JointLimits, Ur3Model, dh_fk, dh_link
+from ur3hanoi.robot import DH_A, DH_D, T_BASELINK_BASE, JointLimits, Ur3Model, dh_link
 
 Branch = tuple[int, int, int]
 
@@ -41,9 +41,9 @@ def wrap_angle(x: FloatArray | float) -> FloatArray:
 
 def pose_errors(T_actual: pin.SE3, T_target: pin.SE3) -> tuple[float, float]:
     """(position error [m], orientation error [rad]) between two poses."""
-    dp = float(np.linalg.norm(T_actual.translation - T_target.translation))
+    dp = math.dist(T_actual.translation.tolist(), T_target.translation.tolist())
     dR = T_actual.rotation.T @ T_target.rotation
-    return dp, float(np.linalg.norm(pin.log3(dR)))
+    return dp, math.hypot(*pin.log3(dR).tolist())
 
 
 # ------------------------------------------------------------------------------------------------ branches
@@ -51,7 +51,9 @@ def pose_errors(T_actual: pin.SE3, T_target: pin.SE3) -> tuple[float, float]:
 
 def _p05(q: FloatArray) -> FloatArray:
     """Origin of DH frame 5 (the wrist point used for the shoulder branch) in base [m]."""
-    T06 = dh_fk(q)
+    T06 = dh_link(q[0], 0)  # one configuration: six 4x4 products beat the batched dh_fk's set-up
+    for i in range(1, 6):
+        T06 = T06 @ dh_link(q[i], i)
     return T06[:3, 3] - DH_D[5] * T06[:3, 2]
 
 
@@ -78,22 +80,28 @@ def analytic_ik(T_base_tool0: FloatArray | pin.SE3, only: Branch | None = None) 
 
     Angles are in [-pi, pi). Singular wrist configurations (sin q5 ~ 0) are skipped. ``only`` restricts the
     solve to one branch (8x cheaper when the branch is known).
+
+    Scalar arithmetic throughout (a table solves one pose at a time, where numpy's per-call cost dominates). With
+    the flange axes X, Y, Z and origin p in ``base`` and UR's DH twists (pi/2, 0, 0, pi/2, -pi/2, 0), joints 2-4
+    form a planar 3R chain in DH frame 1: ``T14 = inv(A1) T06 inv(A5 A6)`` has origin ``(c1 u_x + s1 u_y,
+    u_z - d1)`` with ``u = p + d5 (s6 X + c6 Y) - d6 Z``, and x axis at angle q2 + q3 + q4 with cosine
+    ``c1 w_x + s1 w_y`` and sine ``w_z``, ``w = c5 (c6 X - s6 Y) - s5 Z``.
     """
     T = T_base_tool0.homogeneous if isinstance(T_base_tool0, pin.SE3) else np.asarray(T_base_tool0, dtype=float)
-    d4, d6 = DH_D[3], DH_D[5]
+    (xx, yx, zx, px), (xy, yy, zy, py), (xz, yz, zz, pz) = T[:3].tolist()
+    d1, d4, d5, d6 = DH_D[0], DH_D[3], DH_D[4], DH_D[5]
     a2, a3 = DH_A[1], DH_A[2]
-    R, p = T[:3, :3], T[:3, 3]
-    p05 = p - d6 * R[:, 2]
-    r = math.hypot(p05[0], p05[1])
+    wx, wy = px - d6 * zx, py - d6 * zy  # wrist point p05 (its z is not needed)
+    r = math.hypot(wx, wy)
     out: dict[Branch, FloatArray] = {}
     if r < abs(d4):
         return out
-    psi, phi = math.atan2(p05[1], p05[0]), math.acos(d4 / r)
+    psi, phi = math.atan2(wy, wx), math.acos(d4 / r)
     for s1 in (1, -1) if only is None else (only[0],):
         q1 = psi + s1 * phi + math.pi / 2
         c1, sn1 = math.cos(q1), math.sin(q1)
-        z1 = np.array([sn1, -c1, 0.0])  # joint 2..4 axis in base
-        c5 = (float(p @ z1) - d4) / d6
+        # z1 = (sin q1, -cos q1, 0): the axis of joints 2-4 in base.
+        c5 = (px * sn1 - py * c1 - d4) / d6
         if abs(c5) > 1.0:
             continue
         for s5 in (1, -1) if only is None else (only[2],):
@@ -101,27 +109,24 @@ def analytic_ik(T_base_tool0: FloatArray | pin.SE3, only: Branch | None = None) 
             sin5 = math.sin(q5)
             if abs(sin5) < 1e-10:
                 continue
-            q6 = math.atan2(-float(R[:, 1] @ z1) / sin5, float(R[:, 0] @ z1) / sin5)
-            # Planar 3R problem (joints 2-4) in DH frame 1.
-            T14 = _inv_h(dh_link(q1, 0)) @ T @ _inv_h(dh_link(q5, 4) @ dh_link(q6, 5))
-            px, py = T14[0, 3], T14[1, 3]
-            c3 = (px * px + py * py - a2 * a2 - a3 * a3) / (2 * a2 * a3)
+            q6 = math.atan2(-(yx * sn1 - yy * c1) / sin5, (xx * sn1 - xy * c1) / sin5)  # Y.z1, X.z1
+            c6, sn6 = math.cos(q6), math.sin(q6)
+            ux = px + d5 * (sn6 * xx + c6 * yx) - d6 * zx
+            uy = py + d5 * (sn6 * xy + c6 * yy) - d6 * zy
+            uz = pz + d5 * (sn6 * xz + c6 * yz) - d6 * zz
+            wx5 = c5 * (c6 * xx - sn6 * yx) - sin5 * zx
+            wy5 = c5 * (c6 * xy - sn6 * yy) - sin5 * zy
+            wz5 = c5 * (c6 * xz - sn6 * yz) - sin5 * zz
+            ex, ey = c1 * ux + sn1 * uy, uz - d1  # origin of frame 4 in DH frame 1 (the planar problem)
+            c3 = (ex * ex + ey * ey - a2 * a2 - a3 * a3) / (2 * a2 * a3)
             if abs(c3) > 1.0:
                 continue
+            q234 = math.atan2(wz5, c1 * wx5 + sn1 * wy5)
             for s3 in (1, -1) if only is None else (only[1],):
                 q3 = s3 * math.acos(c3)
-                q2 = math.atan2(py, px) - math.atan2(a3 * math.sin(q3), a2 + a3 * math.cos(q3))
-                q4 = math.atan2(T14[1, 0], T14[0, 0]) - q2 - q3
+                q2 = math.atan2(ey, ex) - math.atan2(a3 * math.sin(q3), a2 + a3 * math.cos(q3))
                 # By construction the branch is (s1, s3, s5): see branch_of.
-                out[(s1, s3, s5)] = wrap_angle(np.array([q1, q2, q3, q4, q5, q6]))
-    return out
-
-
-def _inv_h(T: FloatArray) -> FloatArray:
-    out = np.empty((4, 4))
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -out[:3, :3] @ T[:3, 3]
-    out[3] = (0.0, 0.0, 0.0, 1.0)
+                out[(s1, s3, s5)] = wrap_angle(np.array([q1, q2, q3, q234 - q2 - q3, q5, q6]))
     return out
 
 
@@ -328,17 +333,24 @@ def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3, q_home: FloatArray, l
                           f"residual of {best.position_error * 1e3:.1f} mm, {math.degrees(best.orientation_error):.1f}"
                           " deg)")
         raise IKError(f"{where()} has no solution on home's branch {home_branch} (reachable: {reachable})")
-    seed = q_home + wrap_angle(branches[home_branch] - q_home)
+    q_closed = branches[home_branch]
+    seed = nearest_equivalent(q_closed, q_home, robot.limits)
+    if seed is None:
+        raise IKError(f"{where()}: solution {np.round(np.degrees(q_closed), 3).tolist()} deg is outside the joint "
+                      "limits")
     res = closed_form_result(robot, T_base_tcp, seed)
-    if not res.converged:
-        res = solver.solve(T_base_tcp, seed)
-    q = nearest_equivalent(res.q, q_home, robot.limits)
+    if res.converged:
+        return res
+    refined = solver.solve(T_base_tcp, seed)
+    q = nearest_equivalent(refined.q, q_home, robot.limits)
     if q is None:
-        raise IKError(f"{where()}: solution {np.round(np.degrees(res.q), 3).tolist()} deg is outside the joint limits")
-    res = IKResult(q=q, position_error=res.position_error, orientation_error=res.orientation_error,
-                   iterations=res.iterations, solver=res.solver)
-    # The refined solution must be the closed-form one it started from (so, on home's branch): the URDF and
-    # DH models differ by ~1e-11, far below this bound, while other IK solutions are radians away.
+        raise IKError(f"{where()}: solution {np.round(np.degrees(refined.q), 3).tolist()} deg is outside the joint "
+                      "limits")
+    res = IKResult(q=q, position_error=refined.position_error, orientation_error=refined.orientation_error,
+                   iterations=refined.iterations, solver=refined.solver)
+    # The refined solution must be the closed-form one it started from (so, on home's branch): a robot model that
+    # differs from the DH geometry by micrometres moves it by far less than this bound, while other IK solutions
+    # are radians away.
     drift = float(np.max(np.abs(wrap_angle(res.q - seed))))
     if not res.converged or drift > 1e-6:
         raise IKError(
