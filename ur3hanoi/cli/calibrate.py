@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -40,6 +39,8 @@ def add(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import json
+
     from ur3hanoi.audit import audit_taught
     from ur3hanoi.calibrate import fit_station, write_calibration
     from ur3hanoi.io.atomic import check_output

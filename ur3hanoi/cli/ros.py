@@ -9,7 +9,6 @@ fault exits with 3. Heavy imports (MuJoCo, rospy) happen only when a command run
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 from pathlib import Path
@@ -132,6 +131,8 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_solve(args: argparse.Namespace) -> int:
+    import json
+
     import numpy as np
 
     from ur3hanoi.errors import SuctionFaultError
