@@ -6,10 +6,11 @@ Targets (issue 18): every `--help` <= 0.08 s; cold `plan` on a shipped station <
 an 18-pose IK table <= 1 ms.
 
 Each command is a new process of this interpreter (`python -m ur3hanoi ...`, as a fresh clone runs it), timed from
-start to exit; figures are the median (and best) of N runs after one warm-up run. Byte code is cached as after an
-install (PYTHONDONTWRITEBYTECODE is dropped; the cache goes to a temporary PYTHONPYCACHEPREFIX), and the user's
-cache is a temporary XDG_CACHE_HOME: the first `plan` fills it (reported apart), the timed ones use it. Wall times
-on a shared machine vary with its load, printed beside them.
+start to exit; figures are the median (and best) of N runs after one warm-up run, with the median CPU time (user +
+system) of the process. Byte code is cached as after an install (PYTHONDONTWRITEBYTECODE is dropped; the cache goes
+to a temporary PYTHONPYCACHEPREFIX), and the user's cache is a temporary XDG_CACHE_HOME: the first `plan` fills it
+(reported apart), the timed ones use it. Wall times on a shared machine grow with its load (printed beside them);
+the CPU time of a single-threaded command does not wait for a core (numpy's BLAS threads add to it, though).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import argparse
 import contextlib
 import os
 import platform
+import resource
 import statistics
 import subprocess
 import sys
@@ -25,6 +27,7 @@ import tempfile
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import NamedTuple
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
@@ -56,23 +59,36 @@ class Runner:
                         PYTHONPATH=os.pathsep.join(filter(None, (str(REPO), os.environ.get("PYTHONPATH")))))
         self.tmp = tmp
 
-    def once(self, argv: Sequence[str], **env: str) -> float:
+    def once(self, argv: Sequence[str], **env: str) -> Timing:
+        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         proc = subprocess.run([sys.executable, *argv], cwd=self.tmp, env={**self.env, **env}, stdout=subprocess.DEVNULL,
                               stderr=subprocess.PIPE, text=True, check=False)
         wall = time.perf_counter() - t0
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         if proc.returncode != 0:
             raise SystemExit(f"{' '.join(argv)} failed (exit {proc.returncode}): {proc.stderr.strip()[-500:]}")
-        return wall
+        return Timing(wall, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
 
-    def timed(self, argv: Sequence[str], runs: int, warm_up: bool = True) -> list[float]:
+    def timed(self, argv: Sequence[str], runs: int, warm_up: bool = True) -> list[Timing]:
         if warm_up:
             self.once(argv)
         return [self.once(argv) for _ in range(runs)]
 
 
-def summary(walls: list[float], target_s: float | None = None) -> str:
-    text = f"median {statistics.median(walls):.3f} s, best {min(walls):.3f} s ({len(walls)} runs"
+class Timing(NamedTuple):
+    """One run: wall time [s] from start to exit, and the process's CPU time [s] (user + system)."""
+
+    wall: float
+    cpu: float
+
+
+def summary(runs: list[Timing], target_s: float | None = None) -> str:
+    """Wall median and best, and the median CPU time: on a busy machine the wall time includes waiting for a core,
+    the CPU time does not (for a single-threaded command it is what the wall time is on an idle machine)."""
+    walls = [r.wall for r in runs]
+    text = (f"wall median {statistics.median(walls):.3f} s, best {min(walls):.3f} s; CPU median "
+            f"{statistics.median(r.cpu for r in runs):.3f} s ({len(runs)} runs")
     return text + (f"; target <= {target_s:g} s)" if target_s is not None else ")")
 
 
@@ -88,7 +104,15 @@ def per_call_us(fn: Callable[[], object], repeats: int) -> float:
 
 def bench_ik_station(name: str, repeats: int) -> list[str]:
     from ur3hanoi.grid import T_base_tcp
-    from ur3hanoi.ik import SOLVERS, analytic_ik, branch_of, closed_form_result, make_solver, solve_on_branch
+    from ur3hanoi.ik import (
+        SOLVERS,
+        IKSolver,
+        analytic_ik,
+        branch_of,
+        closed_form_result,
+        make_solver,
+        solve_on_branch,
+    )
     from ur3hanoi.robot import load_ur3
     from ur3hanoi.station import load_station
     from ur3hanoi.waypoints import generate_table
@@ -106,8 +130,11 @@ def bench_ik_station(name: str, repeats: int) -> list[str]:
     table_us = per_call_us(lambda: [solve_on_branch(solvers["pinocchio"], T, q_home, home_branch=home)
                                     for T in targets], repeats)
     closed_us = per_call_us(lambda: [closed_form_result(robot, T, q) for T, q in pairs], repeats)
-    refine_us = {s: per_call_us(lambda solver=solver: [solver.solve(T, q) for T, q in pairs], max(3, repeats // 10))
-                 for s, solver in solvers.items()}
+
+    def refine_all(solver: IKSolver) -> Callable[[], object]:
+        return lambda: [solver.solve(T, q) for T, q in pairs]
+
+    refine_us = {s: per_call_us(refine_all(solver), max(3, repeats // 10)) for s, solver in solvers.items()}
     generate_us = per_call_us(lambda: generate_table(station, solvers["pinocchio"]), repeats)
     refined = sum(r.iterations > 0 for r in generate_table(station, "pinocchio").results)
     return [
@@ -125,7 +152,7 @@ def main() -> int:
     args = ap.parse_args()
     from ur3hanoi.cli import build_parser
 
-    commands = list(next(a for a in build_parser()._actions if a.dest == "command").choices)  # type: ignore[attr-defined]
+    commands = list(next(a for a in build_parser()._actions if a.dest == "command").choices or ())
     print(f"machine: {machine()}; load average {load_average()} at start")
     with tempfile.TemporaryDirectory(prefix="ur3hanoi-bench-") as tmp_name:
         run = Runner(Path(tmp_name))
@@ -141,7 +168,7 @@ def main() -> int:
             argv = ["-m", "ur3hanoi", "plan", "--start", "1", "--end", "3", "--calibration", station]
             first = run.once(argv)  # lab_sim: empty user cache; lab_real: same robot and tool, so already filled
             print(f"cold ur3hanoi plan --start 1 --end 3 --calibration {station}: "
-                  f"{summary(run.timed(argv, plan_runs, warm_up=False), PLAN_TARGET_S)}; first run {first:.3f} s"
+                  f"{summary(run.timed(argv, plan_runs, warm_up=False), PLAN_TARGET_S)}; first run {first.wall:.3f} s"
                   + (" (empty user cache)" if station == "lab_sim" else ""))
         out = str(Path(tmp_name) / "lab2_data.yaml")
         walls = run.timed(["-m", "ur3hanoi", "tables", "lab_sim", "--key", "sim_pos", "-o", out], plan_runs)
