@@ -147,15 +147,18 @@ def test_remove_block_stacked_names_the_block_that_is_missing(height: int) -> No
 
 
 def test_a_block_knocked_by_the_dropped_one_is_reported_after_the_halt() -> None:
-    # Measured with the current planner: lab_real, tower 3 -> 2, the red block dropped in move 7 hits the yellow one
-    # (placed in move 6) and pushes it about 1.5 mm: far within the 5 mm "at its slot" tolerance, so only the
-    # displacement since the fault shows it.
-    r = run_faulty(("lab_real", 2, 1), Faults(drop_during_move=6))
+    # Measured with the current planner: lab_real, tower 2 -> 3, the red block dropped in move 7 hits the stack it
+    # was carried to and pushes the green and yellow blocks about 2.8-2.9 mm: within the 5 mm "at its slot"
+    # tolerance, so only the displacement since the fault shows it. (Where a dropped block lands is chaotic: a
+    # plan that changes by 1e-11 rad, as the closed-form IK table did, moves it; find another case then.)
+    r = run_faulty(("lab_real", 1, 2), Faults(drop_during_move=6))
     knocked = {d.block: d for d in r.displaced_blocks}
-    assert set(knocked) == {1}, r.displaced_blocks
-    assert 0.001 < knocked[1].moved_m < 0.005 and (knocked[1].tower, knocked[1].height) == (1, 1)
-    assert "yellow block 2 was knocked" in (r.error or "") and "tower 2 height 2" in (r.error or "")
-    assert r.as_dict()["fault"]["displaced_blocks"][0]["block"] == 2
+    assert set(knocked) == {0, 1}, r.displaced_blocks
+    for b in (0, 1):
+        assert 0.001 < knocked[b].moved_m < 0.005 and (knocked[b].tower, knocked[b].height) == (2, b)
+    assert "green block 1 was knocked" in (r.error or "") and "tower 3 height 1" in (r.error or "")
+    assert "yellow block 2 was knocked" in (r.error or "") and "tower 3 height 2" in (r.error or "")
+    assert [d["block"] for d in r.as_dict()["fault"]["displaced_blocks"]] == [1, 2]
 
 
 @pytest.mark.parametrize(("shift_mm", "reported"), [(0.5, False), (3.0, True)])
