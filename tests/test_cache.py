@@ -8,7 +8,6 @@ import json
 import subprocess
 import sys
 import textwrap
-import time
 from pathlib import Path
 
 import coal
@@ -188,7 +187,8 @@ def test_corrupt_collision_entry_is_rebuilt(lab_sim: Station, private_cache: Pat
 
 
 _RACER = textwrap.dedent("""
-    import hashlib, sys, time
+    import hashlib, os, sys, time
+    from pathlib import Path
     import numpy as np
     import ur3hanoi.cache as cache
     from ur3hanoi.plan.collision import CollisionScene
@@ -203,7 +203,10 @@ _RACER = textwrap.dedent("""
         return real_store(kind, key, payload)
     cache.load, cache.store = load, store
     station = load_station("lab_sim")
-    while time.time() < float(sys.argv[1]):  # both processes look at the cache at the same moment
+    ready, n_racers = Path(sys.argv[1]), int(sys.argv[3])
+    (ready / str(os.getpid())).touch()
+    deadline = time.monotonic() + 60
+    while len(list(ready.iterdir())) < n_racers and time.monotonic() < deadline:  # all racers start together
         time.sleep(0.001)
     scene = CollisionScene(station, 3)
     scene.place_blocks({0: (0, 0), 1: (1, 0), 2: (2, 0)})
@@ -213,23 +216,23 @@ _RACER = textwrap.dedent("""
 """)
 
 
-def _racer(start: float, hold_s: float) -> subprocess.Popen[str]:
-    return subprocess.Popen([sys.executable, "-c", _RACER, f"{start:.3f}", str(hold_s)], cwd=REPO,
+def _racer(ready: Path, hold_s: float, n_racers: int) -> subprocess.Popen[str]:
+    ready.mkdir(exist_ok=True)
+    return subprocess.Popen([sys.executable, "-c", _RACER, str(ready), str(hold_s), str(n_racers)], cwd=REPO,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
-def test_two_processes_racing_on_an_empty_cache(private_cache: Path) -> None:
+def test_two_processes_racing_on_an_empty_cache(private_cache: Path, tmp_path: Path) -> None:
     """Both miss and build at once, and both write; each gets a correct scene, one whole entry remains and nothing
     else (no temporary or lock file); a third process then hits it and computes the same distances."""
-    start = time.time() + 4.0  # after both have imported Pinocchio
-    procs = [_racer(start, 1.0) for _ in range(2)]
+    procs = [_racer(tmp_path / "ready", 1.0, 2) for _ in range(2)]  # both wait until both have imported Pinocchio
     outs = [p.communicate(timeout=120) for p in procs]
     assert [p.returncode for p in procs] == [0, 0], [err for _, err in outs]
     (status_a, digest_a), (status_b, digest_b) = (out.split() for out, _ in outs)
     assert status_a == status_b == "miss"
     entries = sorted(private_cache.iterdir())
     assert [p.suffix for p in entries] == [".cache"], entries
-    third = _racer(0.0, 0.0)
+    third = _racer(tmp_path / "ready-third", 0.0, 1)
     out, err = third.communicate(timeout=120)
     assert third.returncode == 0, err
     assert out.split() == ["hit", digest_a] and digest_a == digest_b
