@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import subprocess
 import sys
 import time
@@ -42,11 +43,16 @@ def main() -> int:
         print(f"{name}: plan {t_plan:.2f} s; sim {r.sim_time_s:.1f} s in {r.wall_time_s:.2f} s wall; realtime factor "
               f"best {max(rtfs):.1f}x median {sorted(rtfs)[len(rtfs) // 2]:.1f}x; max tracking error "
               f"{max(errs):.3f} deg")
-    exe = REPO / ".venv/bin/ur3hanoi"
-    cmd = [str(exe) if exe.exists() else "ur3hanoi", "solve", "--start", "1", "--end", "3", "--json"]
+    # This interpreter runs the command (`python -m ur3hanoi`), so no `ur3hanoi` on PATH is needed; the checkout
+    # is put first on PYTHONPATH like the sys.path line above.
+    cmd = [sys.executable, "-m", "ur3hanoi", "solve", "--start", "1", "--end", "3", "--json"]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (str(REPO), os.environ.get("PYTHONPATH"))))}
     t0 = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO, check=False)
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO, env=env, check=False)
     wall = time.perf_counter() - t0
+    if proc.returncode not in (0, 3) or not proc.stdout.strip():
+        print(f"`ur3hanoi solve` failed (exit {proc.returncode}): {proc.stderr.strip()[-500:]}", file=sys.stderr)
+        return 1
     out = json.loads(proc.stdout)
     print(f"`ur3hanoi solve --start 1 --end 3` end to end: {wall:.2f} s wall (exit {proc.returncode}, status "
           f"{out['status']}, sim {out['sim_time_s']:.1f} s, loop realtime factor {out['realtime_factor']:.1f}x)")

@@ -1,4 +1,5 @@
-"""IK accuracy (measured by FK), branch control, agreement of the Pinocchio and placo solvers."""
+"""IK accuracy (measured by FK), branch control, agreement of the Pinocchio and placo solvers, and the closed form
+taken first: refined only where FK says it misses the tolerances."""
 
 from __future__ import annotations
 
@@ -10,15 +11,20 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import ur3hanoi.robot
 from ur3hanoi.errors import IKError, Ur3HanoiError
 from ur3hanoi.grid import R_world_tcp_down, T_base_tcp
 from ur3hanoi.ik import (
     BRANCHES,
+    CLOSED_FORM,
     ORIENTATION_TOL,
     POSITION_TOL,
     SOLVERS,
+    IKResult,
+    IKSolver,
     analytic_ik,
     branch_of,
+    closed_form_result,
     make_solver,
     nearest_equivalent,
     pose_errors,
@@ -195,3 +201,81 @@ def test_property_fk_ik_fk_on_own_branch(q_list: list[float]) -> None:
     b = branch_of(q)
     assert b in sols
     assert np.abs(dh_fk(sols[b]) - T).max() < 1e-9
+
+
+# ----------------------------------------------------------------------------- closed form first, then refine
+
+
+class CountingSolver:
+    """An :class:`IKSolver` that counts the refinements it is asked for."""
+
+    def __init__(self, inner: IKSolver) -> None:
+        self.inner, self.name, self.robot, self.calls = inner, inner.name, inner.robot, 0
+
+    def solve(self, T_base_tcp: pin.SE3, q_seed: np.ndarray) -> IKResult:
+        self.calls += 1
+        return self.inner.solve(T_base_tcp, q_seed)
+
+
+ELBOW_ORIGIN = 'xyz="0.0 -0.0925 0.24365"'
+ELBOW_OFFSET_M = 2e-8
+"""A robot whose upper arm is 20 nm longer than the DH table's (as a calibrated robot's is): the closed form then
+misses the URDF model's poses by about 1e-8 m, ten times the tolerance, and must be refined."""
+
+
+@pytest.fixture(scope="module")
+def longer_arm(lab_sim: Station) -> Ur3Model:
+    original = ur3hanoi.robot.urdf_text
+
+    def perturbed(*args: object, **kwargs: object) -> str:
+        text = original(*args, **kwargs)  # type: ignore[arg-type]
+        assert text.count(ELBOW_ORIGIN) == 1
+        return text.replace(ELBOW_ORIGIN, f'xyz="0.0 -0.0925 {0.24365 + ELBOW_OFFSET_M!r}"')
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(ur3hanoi.robot, "urdf_text", perturbed)
+        return Ur3Model(lab_sim.tool, lab_sim.limits)  # not load_ur3: its cache must keep the true model
+
+
+@pytest.mark.parametrize("solver_name", SOLVERS)
+def test_closed_form_alone_on_every_table_pose(shipped_station: Station, solver_name: str) -> None:
+    """On the UR3's own model the closed form is within the tolerances: no refinement, and FK confirms it."""
+    robot = load_ur3(shipped_station.tool, shipped_station.limits)
+    solver = CountingSolver(make_solver(solver_name, robot))
+    q_home = shipped_station.q_home_array
+    for t in range(shipped_station.n_towers):
+        for h in range(shipped_station.n_heights):
+            for k in (0, 1):
+                T = T_base_tcp(shipped_station, t, h, k)
+                res = solve_on_branch(solver, T, q_home)
+                assert (res.solver, res.iterations) == (CLOSED_FORM, 0)
+                dp, dr = pose_errors(robot.fk(res.q), T)
+                assert dp <= POSITION_TOL and dr <= ORIENTATION_TOL
+                # The reported residual is this FK's (up to the 2pi shift of the joints toward home).
+                assert (dp, dr) == pytest.approx((res.position_error, res.orientation_error), abs=1e-14)
+    assert solver.calls == 0
+
+
+@pytest.mark.parametrize("solver_name", SOLVERS)
+def test_refined_where_the_closed_form_misses(longer_arm: Ur3Model, lab_sim: Station, solver_name: str) -> None:
+    """On a model that differs from the DH geometry the closed form misses by ~1e-8 m: the chosen solver refines
+    every pose to the tolerances, on home's branch, measured by FK of that model."""
+    solver = CountingSolver(make_solver(solver_name, longer_arm))
+    q_home = lab_sim.q_home_array
+    T_tcp_tool0 = longer_arm.T_tcp_tool0
+    n = 0
+    for t in range(lab_sim.n_towers):
+        for h in range(lab_sim.n_heights):
+            for k in (0, 1):
+                T = T_base_tcp(lab_sim, t, h, k)
+                q_closed = analytic_ik(T * T_tcp_tool0, only=HOME_BRANCH)[HOME_BRANCH]
+                missed = closed_form_result(longer_arm, T, q_closed)
+                assert not missed.converged and missed.position_error > 5 * POSITION_TOL
+                res = solve_on_branch(solver, T, q_home)
+                assert res.solver == solver_name and res.iterations >= 1
+                dp, dr = pose_errors(longer_arm.fk(res.q), T)
+                assert dp <= POSITION_TOL and dr <= ORIENTATION_TOL
+                assert branch_of(res.q) == HOME_BRANCH
+                assert 1e-10 < np.abs(wrap_angle(res.q - q_closed)).max() < 1e-6  # moved, but stayed put
+                n += 1
+    assert solver.calls == n == 18

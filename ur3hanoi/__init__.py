@@ -4,7 +4,8 @@ Modules, one concept each: :mod:`~ur3hanoi.robot` (UR3 model, frames, limits), :
 (calibration files), :mod:`~ur3hanoi.grid` (Cartesian tower grid), :mod:`~ur3hanoi.ik` (inverse kinematics),
 :mod:`~ur3hanoi.waypoints` (the joint table by IK), :mod:`~ur3hanoi.labfile` (``lab2_data.yaml``),
 :mod:`~ur3hanoi.taught` and :mod:`~ur3hanoi.calibrate` (calibration from taught poses), :mod:`~ur3hanoi.io`
-(the one YAML loader, schemas, the one atomic writer), :mod:`~ur3hanoi.cli` (the ``ur3hanoi`` command).
+(the one YAML loader, schemas, the one atomic writer), :mod:`~ur3hanoi.cache` (the user's cache of derived data),
+:mod:`~ur3hanoi.cli` (the ``ur3hanoi`` command).
 """
 
 __version__ = "0.1.0"

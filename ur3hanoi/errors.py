@@ -21,10 +21,7 @@ Hierarchy::
 from __future__ import annotations
 
 import reprlib
-from typing import TYPE_CHECKING, Any, Self
-
-if TYPE_CHECKING:  # typing only: importing ur3hanoi.sim at run time would load MuJoCo and the planner
-    from ur3hanoi.sim.result import SimResult
+from typing import Any, Self
 
 MAX_QUOTE_CHARS = 60
 """Longest quoted value (or path) in an error message [characters]; longer ones are cut with ``...``."""
@@ -134,11 +131,13 @@ class SuctionFaultError(Ur3HanoiError):
     """Suction feedback says no block is held where one should be (the lab's halt condition).
 
     Raised after the halt (arm stopped, suction off, arm home); ``result`` is the simulator's outcome of the run
-    (status "halted") when the fault comes from :func:`ur3hanoi.sim.run_plan`, else None.
+    (a :class:`ur3hanoi.sim.SimResult`, status "halted") when the fault comes from :func:`ur3hanoi.sim.run_plan`,
+    else None. It is typed ``object`` because this module is the bottom of the package: it imports nothing of
+    ur3hanoi, so every module can import it without a cycle.
     """
 
     exit_code = 3
 
-    def __init__(self, message: str, result: SimResult | None = None) -> None:
+    def __init__(self, message: str, result: object | None = None) -> None:
         super().__init__(message)
         self.result = result

@@ -43,6 +43,7 @@ import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import MISSING, CalibrationError, printable
+from ur3hanoi.io.limits import MAX_HEIGHTS, MAX_TOWERS
 from ur3hanoi.io.schema import Choice, Field, ListOf, Number, Record, Text, Vector
 from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
@@ -63,9 +64,6 @@ from ur3hanoi.suction_profile import (
 Vec3 = tuple[float, float, float]
 Layout = Literal["flat", "stacked"]
 LAYOUTS: tuple[str, ...] = ("flat", "stacked")
-
-MAX_TOWERS = 10
-MAX_HEIGHTS = 20
 
 
 @dataclass(frozen=True)

@@ -3,15 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 from ur3hanoi.cli.common import SYMLINK_NOTE, input_file, shown
-from ur3hanoi.cli.options import UsageError
+from ur3hanoi.cli.options import TABLE_KEYS, UsageError
 from ur3hanoi.errors import printable, quote
 from ur3hanoi.io.schema import Text
-from ur3hanoi.labfile import TABLE_KEYS
 
 _NAME = Text(max_len=255)
 
@@ -41,6 +39,8 @@ def add(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import json
+
     from ur3hanoi.audit import audit_taught
     from ur3hanoi.calibrate import fit_station, write_calibration
     from ur3hanoi.io.atomic import check_output

@@ -4,11 +4,9 @@ the table itself (``--fit``); see :mod:`ur3hanoi.audit`."""
 from __future__ import annotations
 
 import argparse
-import json
 
 from ur3hanoi.cli import exit_codes
-from ur3hanoi.cli.options import TOL_DEG, TOL_MM, UsageError, option
-from ur3hanoi.labfile import TABLE_KEYS
+from ur3hanoi.cli.options import TABLE_KEYS, TOL_DEG, TOL_MM, UsageError, option
 
 
 def add(sub: argparse._SubParsersAction) -> None:
@@ -47,6 +45,8 @@ def add(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import json
+
     from ur3hanoi.audit import STRICT_DEG, STRICT_MM, audit_table, check_against, default_base
     from ur3hanoi.labfile import read_recorded_table
     from ur3hanoi.station import load_station

@@ -7,7 +7,6 @@ from pathlib import Path
 from typing import Any
 
 from ur3hanoi.errors import printable
-from ur3hanoi.resources import station_file
 
 DEFAULT_CALIBRATION = "lab_sim"
 
@@ -21,6 +20,8 @@ def calibration_ref(arg: str | None) -> str:
 
 def input_file(ref: str) -> Path:
     """The file behind a calibration argument (a shipped station name or a path)."""
+    from ur3hanoi.resources import station_file
+
     return station_file(ref)
 
 

@@ -11,13 +11,17 @@ import argparse
 from collections.abc import Callable
 
 from ur3hanoi.errors import Ur3HanoiError, quote
+from ur3hanoi.io.limits import MAX_HEIGHTS, MAX_TOWERS
 from ur3hanoi.io.schema import Number
-from ur3hanoi.station import MAX_HEIGHTS, MAX_TOWERS
 
 
 class UsageError(Ur3HanoiError):
     """A command-line option is missing, invalid, or inconsistent with another one (exit code 2)."""
 
+
+TABLE_KEYS: tuple[str, ...] = ("sim_pos", "real_pos")
+"""The lab file's table keys for ``--key``: :data:`ur3hanoi.labfile.TABLE_KEYS` spelt out, so that building the
+parser does not load numpy (tests/test_cli_startup.py checks that both are the same)."""
 
 MAX_BLOCKS = 10
 """Most blocks a plan or a solve takes (1023 moves)."""

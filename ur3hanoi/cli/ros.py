@@ -9,7 +9,6 @@ fault exits with 3. Heavy imports (MuJoCo, rospy) happen only when a command run
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 from pathlib import Path
@@ -161,6 +160,8 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_solve(args: argparse.Namespace) -> int:
+    import json
+
     import numpy as np
 
     from ur3hanoi.errors import SuctionFaultError
@@ -238,8 +239,9 @@ def _add_env(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_env(args: argparse.Namespace) -> int:
-    from ur3hanoi.ros.env import default_cache_dir, env_lines, write_client_env
+    from ur3hanoi.ros.env import default_cache_dir, env_lines
     from ur3hanoi.ros.master import MasterUri, master_uri_from_env
+    from ur3hanoi.ros.msgs import write_client_env
 
     folder = Path(args.dir).resolve() if args.dir else default_cache_dir()
     uri = args.master or master_uri_from_env()

@@ -36,6 +36,7 @@ from ur3hanoi.cli.options import (
     SEED,
     SIM_TIME,
     SPEED,
+    TABLE_KEYS,
     TOWER,
     UsageError,
     check_blocks,
@@ -46,7 +47,6 @@ from ur3hanoi.cli.options import (
     option,
 )
 from ur3hanoi.errors import SuctionFaultError, Ur3HanoiError
-from ur3hanoi.labfile import TABLE_KEYS
 
 if TYPE_CHECKING:
     from ur3hanoi.sim import ProgressFn
@@ -249,6 +249,7 @@ def run(args: argparse.Namespace) -> int:
         Faults,
         OffscreenRecorder,
         SimConfig,
+        SimResult,
         ViewerSink,
         build_task_scene,
         display_available,
@@ -289,7 +290,7 @@ def run(args: argparse.Namespace) -> int:
                               scene=scene, realtime=args.view)
         except SuctionFaultError as exc:
             # A halted run still has a result to report (the final block positions, the halt).
-            if exc.result is None:
+            if not isinstance(exc.result, SimResult):
                 raise
             result, fault = exc.result, exc
     except BaseException:

@@ -23,3 +23,9 @@ MAX_INT_DIGITS = 30
 
 MAX_LIST_ITEMS = 10_000
 """Longest list a schema accepts unless it says otherwise."""
+
+MAX_TOWERS = 10
+"""Most towers of a station's grid (``grid.towers``)."""
+
+MAX_HEIGHTS = 20
+"""Most heights of a station's grid (``grid.heights``)."""

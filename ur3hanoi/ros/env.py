@@ -6,7 +6,7 @@ imports them once that folder is on ``sys.path``; it is **appended** (never prep
 numpy and PyYAML keep precedence over Debian's copies.
 
 A lab program (``lab2_exec.py``) needs ``rospy`` and the course's ``ur3_driver.msg`` package.
-:func:`write_client_env` writes a folder with the generated ``ur3_driver`` package (see :mod:`ur3hanoi.ros.msgs`)
+:func:`ur3hanoi.ros.msgs.write_client_env` writes a folder with the generated ``ur3_driver`` package
 and a ``sitecustomize.py`` that appends Debian's folder, so that ``PYTHONPATH=<folder>`` is all a Python 3 (the
 venv's or Debian's own) needs; :func:`env_lines` are the shell lines ``ur3hanoi ros-env`` prints.
 """
@@ -120,20 +120,6 @@ def _chain():
 
 _chain()
 '''
-
-
-def write_client_env(folder: Path) -> list[Path]:
-    """Write the ``ur3_driver`` message package and the ``sitecustomize.py`` described above into ``folder``.
-
-    Returns the files written. Existing files are replaced atomically; nothing else in ``folder`` is touched.
-    """
-    from ur3hanoi.io.atomic import atomic_write
-    from ur3hanoi.ros.msgs import write_message_package
-
-    written = write_message_package(folder)
-    site = folder / "sitecustomize.py"
-    atomic_write(site, SITECUSTOMIZE)
-    return [*written, site]
 
 
 def env_lines(folder: Path, master_uri: str) -> list[str]:

@@ -19,7 +19,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from ur3hanoi.ros.env import ensure_ros_python
+from ur3hanoi.ros.env import SITECUSTOMIZE, ensure_ros_python
 from ur3hanoi.ros.errors import RosError
 
 PACKAGE = "ur3_driver"
@@ -112,3 +112,16 @@ def write_message_package(root: Path) -> list[Path]:
     for path, text in files.items():
         atomic_write(path, text)
     return list(files)
+
+
+def write_client_env(folder: Path) -> list[Path]:
+    """Write the ``ur3_driver`` message package and :data:`~ur3hanoi.ros.env.SITECUSTOMIZE` into ``folder``.
+
+    Returns the files written. Existing files are replaced atomically; nothing else in ``folder`` is touched.
+    """
+    from ur3hanoi.io.atomic import atomic_write
+
+    written = write_message_package(folder)
+    site = folder / "sitecustomize.py"
+    atomic_write(site, SITECUSTOMIZE)
+    return [*written, site]

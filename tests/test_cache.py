@@ -1,0 +1,239 @@
+"""The user's cache: content keys, hits, corrupt entries rebuilt, an unwritable cache tolerated, two processes racing,
+and the cached collision geometry equal to a fresh build."""
+
+from __future__ import annotations
+
+import base64
+import json
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import coal
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import ur3hanoi.cache
+from ur3hanoi.cache import COLLISION_GEOMETRY, cache_dir, collision_geometry, content_key, entry_path, load, store
+from ur3hanoi.robot import ToolOffset, Ur3Model, load_ur3
+from ur3hanoi.station import Station
+
+from .conftest import REPO
+
+PAYLOAD = bytes(range(256)) * 1000  # every byte value, 256 kB
+
+
+@pytest.fixture(autouse=True)
+def private_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    return tmp_path / "xdg" / "ur3hanoi"
+
+
+def test_cache_dir_is_the_users(private_cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    assert cache_dir() == private_cache
+    monkeypatch.setenv("XDG_CACHE_HOME", "")
+    monkeypatch.setenv("HOME", "/home/student")
+    assert cache_dir() == Path("/home/student/.cache/ur3hanoi")
+    monkeypatch.delenv("XDG_CACHE_HOME")
+    assert cache_dir() == Path("/home/student/.cache/ur3hanoi")
+
+
+def test_key_is_the_content(monkeypatch: pytest.MonkeyPatch) -> None:
+    key = content_key("demo", [b"station", b"urdf"])
+    assert key == content_key("demo", [b"station", b"urdf"])
+    assert len(key) == 64 and int(key, 16) >= 0
+    others = [content_key("demo", [b"station", b"urdF"]),  # one byte of one input
+              content_key("demo", [b"statio", b"nurdf"]),  # same bytes, other split
+              content_key("demo", [b"station"]),
+              content_key("other", [b"station", b"urdf"])]
+    monkeypatch.setattr(ur3hanoi.cache, "__version__", "99.0")
+    others.append(content_key("demo", [b"station", b"urdf"]))  # another ur3hanoi version
+    assert len({key, *others}) == 6
+
+
+def test_store_then_hit(private_cache: Path) -> None:
+    key = content_key("demo", [b"x"])
+    assert load("demo", key) is None
+    assert store("demo", key, PAYLOAD)
+    assert load("demo", key) == PAYLOAD
+    assert sorted(p.name for p in private_cache.iterdir()) == [f"demo-{key}.cache"]  # no temporary or lock file
+    assert load("demo", content_key("demo", [b"y"])) is None  # another content: a miss
+
+
+def _corrupt(path: Path, how: str) -> None:
+    raw = path.read_bytes()
+    head, body = raw.split(b"\n", 1)
+    header = json.loads(head)
+    if how == "truncated":
+        path.write_bytes(raw[: len(raw) // 2])
+    elif how == "payload byte changed":  # still valid base64, one payload byte differs: the digest catches it
+        payload = bytearray(base64.b64decode(body))
+        payload[1000] ^= 0x01
+        path.write_bytes(head + b"\n" + base64.b64encode(bytes(payload)) + b"\n")
+    elif how == "not base64":
+        path.write_bytes(head + b"\n" + b"@@@" + body[3:])
+    elif how == "header garbage":
+        path.write_bytes(b"\x00\xff{not json\n" + body)
+    elif how == "foreign key":  # a whole, valid entry of another key under this name
+        header["key"] = "0" * 64
+        path.write_bytes(json.dumps(header).encode() + b"\n" + body)
+    elif how == "other format":
+        header["format"] = 0
+        path.write_bytes(json.dumps(header).encode() + b"\n" + body)
+    elif how == "empty":
+        path.write_bytes(b"")
+    elif how == "directory":
+        path.unlink()
+        path.mkdir()
+    else:
+        raise AssertionError(how)
+
+
+@pytest.mark.parametrize("how", ["truncated", "payload byte changed", "not base64", "header garbage", "foreign key",
+                                 "other format", "empty"])
+def test_corrupt_entry_is_ignored_and_rebuilt(how: str) -> None:
+    key = content_key("demo", [b"x"])
+    store("demo", key, PAYLOAD)
+    _corrupt(entry_path("demo", key), how)
+    assert load("demo", key) is None
+    assert store("demo", key, PAYLOAD)  # rewritten
+    assert load("demo", key) == PAYLOAD
+
+
+def test_unusable_cache_costs_only_the_rebuild(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    key = content_key("demo", [b"x"])
+    store("demo", key, PAYLOAD)
+    _corrupt(entry_path("demo", key), "directory")  # the entry's path is a directory: unreadable, unwritable
+    assert load("demo", key) is None
+    assert store("demo", key, PAYLOAD) is False
+    not_a_dir = tmp_path / "file"
+    not_a_dir.write_text("")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(not_a_dir))  # the cache folder cannot be created
+    assert load("demo", key) is None
+    assert store("demo", key, PAYLOAD) is False
+
+
+# ------------------------------------------------------------------------------------- collision geometry
+
+
+def _hulls(robot: Ur3Model, calls: list[int]) -> pin.GeometryModel:
+    """What plan/collision.py builds: the URDF collision meshes as convex hulls."""
+    calls.append(1)
+    gm = pin.buildGeomFromUrdfString(robot.model, robot.urdf, pin.COLLISION)
+    for g in gm.geometryObjects:
+        if isinstance(g.geometry, coal.BVHModelBase):
+            g.geometry.buildConvexRepresentation(False)
+            g.geometry = g.geometry.convex
+    return gm
+
+
+def _distances(robot: Ur3Model, gm: pin.GeometryModel) -> np.ndarray:
+    """Distances [m] of every robot geometry to a few boxes at 20 seeded configurations."""
+    gm = gm.copy()
+    n = gm.ngeoms
+    rng = np.random.default_rng(7)
+    for i, p in enumerate(rng.uniform(-0.3, 0.3, size=(3, 3))):
+        box_object = pin.GeometryObject(f"box{i}", 0, 0, pin.SE3(np.eye(3), p), coal.Box(0.03, 0.03, 0.03))
+        box = gm.addGeometryObject(box_object)
+        for g in range(n):
+            gm.addCollisionPair(pin.CollisionPair(g, box))
+    gd, data = pin.GeometryData(gm), robot.model.createData()
+    out = []
+    for q in rng.uniform(-np.pi, np.pi, size=(20, 6)):
+        pin.updateGeometryPlacements(robot.model, data, gm, gd, q)
+        out.append([pin.computeDistance(gm, gd, k).min_distance for k in range(len(gm.collisionPairs))])
+    return np.array(out)
+
+
+def test_collision_geometry_hit_equals_a_fresh_build(lab_sim: Station, private_cache: Path) -> None:
+    robot = load_ur3(lab_sim.tool, lab_sim.limits)
+    calls: list[int] = []
+    fresh = collision_geometry(robot, lambda: _hulls(robot, calls))
+    assert len(calls) == 1
+    assert [p.name.split("-")[:2] for p in private_cache.iterdir()] == [["collision", "geometry"]]
+    cached = collision_geometry(robot, lambda: _hulls(robot, calls))
+    assert len(calls) == 1  # loaded, not built
+    assert [g.name for g in cached.geometryObjects] == [g.name for g in fresh.geometryObjects]
+    assert [g.parentJoint for g in cached.geometryObjects] == [g.parentJoint for g in fresh.geometryObjects]
+    d_fresh, d_cached = _distances(robot, fresh), _distances(robot, cached)
+    assert d_fresh.min() > -1.0 and np.isfinite(d_fresh).all()
+    np.testing.assert_array_equal(d_cached, d_fresh)  # bit for bit: the same hulls
+
+
+def test_collision_geometry_key_follows_the_robot_model(lab_sim: Station, private_cache: Path) -> None:
+    """Another tool frame is another URDF text: a new entry (the first is kept); the same one is a hit."""
+    calls: list[int] = []
+    robot = load_ur3(lab_sim.tool, lab_sim.limits)
+    other = Ur3Model(ToolOffset(parent="tool0", xyz=(0.0, 0.0, 0.1)), lab_sim.limits)
+    for r in (robot, other, robot, other):
+        collision_geometry(r, lambda r=r: _hulls(r, calls))
+    assert len(calls) == 2
+    assert len(list(private_cache.glob(f"{COLLISION_GEOMETRY}-*.cache"))) == 2
+
+
+def test_corrupt_collision_entry_is_rebuilt(lab_sim: Station, private_cache: Path) -> None:
+    robot = load_ur3(lab_sim.tool, lab_sim.limits)
+    calls: list[int] = []
+    fresh = collision_geometry(robot, lambda: _hulls(robot, calls))
+    (entry,) = private_cache.glob("*.cache")
+    _corrupt(entry, "payload byte changed")
+    rebuilt = collision_geometry(robot, lambda: _hulls(robot, calls))
+    assert len(calls) == 2
+    np.testing.assert_array_equal(_distances(robot, rebuilt), _distances(robot, fresh))
+    collision_geometry(robot, lambda: _hulls(robot, calls))
+    assert len(calls) == 2  # the rebuilt entry is whole again
+
+
+_RACER = textwrap.dedent("""
+    import hashlib, os, sys, time
+    from pathlib import Path
+    import numpy as np
+    import ur3hanoi.cache as cache
+    from ur3hanoi.plan.collision import CollisionScene
+    from ur3hanoi.station import load_station
+    real_load, real_store, first = cache.load, cache.store, []
+    def load(kind, key):
+        payload = real_load(kind, key)
+        first.append("hit" if payload is not None else "miss")
+        return payload
+    def store(kind, key, payload):
+        time.sleep(float(sys.argv[2]))  # hold the built entry back: the other process misses too
+        return real_store(kind, key, payload)
+    cache.load, cache.store = load, store
+    station = load_station("lab_sim")
+    ready, n_racers = Path(sys.argv[1]), int(sys.argv[3])
+    (ready / str(os.getpid())).touch()
+    deadline = time.monotonic() + 60
+    while len(list(ready.iterdir())) < n_racers and time.monotonic() < deadline:  # all racers start together
+        time.sleep(0.001)
+    scene = CollisionScene(station, 3)
+    scene.place_blocks({0: (0, 0), 1: (1, 0), 2: (2, 0)})
+    q = np.array([2.0, -1.2, 1.3, -1.7, -1.57, 0.4])
+    d = scene.distances(q, [(g, scene.table) for g in scene.robot_geoms] + [(scene.cup, b) for b in scene.blocks])
+    print(first[0], hashlib.sha256(d.tobytes()).hexdigest())
+""")
+
+
+def _racer(ready: Path, hold_s: float, n_racers: int) -> subprocess.Popen[str]:
+    ready.mkdir(exist_ok=True)
+    return subprocess.Popen([sys.executable, "-c", _RACER, str(ready), str(hold_s), str(n_racers)], cwd=REPO,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def test_two_processes_racing_on_an_empty_cache(private_cache: Path, tmp_path: Path) -> None:
+    """Both miss and build at once, and both write; each gets a correct scene, one whole entry remains and nothing
+    else (no temporary or lock file); a third process then hits it and computes the same distances."""
+    procs = [_racer(tmp_path / "ready", 1.0, 2) for _ in range(2)]  # both wait until both have imported Pinocchio
+    outs = [p.communicate(timeout=120) for p in procs]
+    assert [p.returncode for p in procs] == [0, 0], [err for _, err in outs]
+    (status_a, digest_a), (status_b, digest_b) = (out.split() for out, _ in outs)
+    assert status_a == status_b == "miss"
+    entries = sorted(private_cache.iterdir())
+    assert [p.suffix for p in entries] == [".cache"], entries
+    third = _racer(tmp_path / "ready-third", 0.0, 1)
+    out, err = third.communicate(timeout=120)
+    assert third.returncode == 0, err
+    assert out.split() == ["hit", digest_a] and digest_a == digest_b
+    assert sorted(private_cache.iterdir()) == entries

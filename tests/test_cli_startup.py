@@ -1,0 +1,81 @@
+"""The command line starts without the heavy libraries: building the parser and every ``--help`` load none of them.
+
+A property, not a timing (timings are in bench/bench_startup.py): which modules a fresh interpreter holds after
+``import ur3hanoi.cli`` and after each command's ``--help``.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+from ur3hanoi.cli import build_parser
+from ur3hanoi.cli.options import TABLE_KEYS
+
+from .conftest import REPO
+
+HEAVY = ("numpy", "pinocchio", "coal", "hppfcl", "mujoco", "placo", "ruckig", "scipy", "yaml")
+"""Libraries the parser must not import: each costs 10-150 ms; the commands import them where they are used."""
+
+_PROBE = """
+import contextlib, io, json, sys
+import ur3hanoi.cli
+heavy = {heavy!r}
+def loaded():
+    return sorted(m for m in sys.modules if m.split(".")[0] in heavy)
+out = {{"import": loaded()}}
+for argv in {argvs!r}:
+    with contextlib.redirect_stdout(io.StringIO()) as text:
+        code = ur3hanoi.cli.main([*argv, "--help"])
+    out[" ".join(argv) or "ur3hanoi"] = [code, len(text.getvalue()), loaded()]
+print(json.dumps(out))
+"""
+
+
+def _commands() -> list[list[str]]:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.dest == "command")
+    return [[], *([name] for name in sub.choices)]  # type: ignore[attr-defined]
+
+
+def _probe(code: str) -> dict[str, object]:
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout)  # type: ignore[no-any-return]
+
+
+def test_parser_and_every_help_import_no_heavy_library() -> None:
+    commands = _commands()
+    assert len(commands) >= 7  # ur3hanoi itself and its commands (tables, check-table, ..., ros-env)
+    out = _probe(_PROBE.format(heavy=HEAVY, argvs=commands))
+    assert out.pop("import") == []
+    assert set(out) == {" ".join(c) or "ur3hanoi" for c in commands}
+    for name, (code, n_chars, loaded) in out.items():  # type: ignore[misc]
+        assert code == 0 and n_chars > 200, f"{name} --help: exit {code}, {n_chars} characters"
+        assert loaded == [], f"{name} --help imported {loaded}"
+
+
+def test_the_probe_sees_a_heavy_import() -> None:
+    """The check can fail: the same probe after a library import reports it."""
+    out = _probe("import numpy\n" + _PROBE.format(heavy=HEAVY, argvs=[["tables"]]))
+    assert "numpy" in out["import"]  # type: ignore[operator]
+
+
+def test_parser_constants_are_the_library_constants() -> None:
+    """The parser spells out what it would otherwise import from numpy-heavy modules: the same values."""
+    from ur3hanoi.io.limits import MAX_HEIGHTS, MAX_TOWERS
+    from ur3hanoi.labfile import TABLE_KEYS as LAB_TABLE_KEYS
+    from ur3hanoi.station import MAX_HEIGHTS as STATION_MAX_HEIGHTS
+    from ur3hanoi.station import MAX_TOWERS as STATION_MAX_TOWERS
+
+    assert TABLE_KEYS == LAB_TABLE_KEYS
+    assert (MAX_TOWERS, MAX_HEIGHTS) == (STATION_MAX_TOWERS, STATION_MAX_HEIGHTS)
+
+
+def test_python_m_ur3hanoi_is_the_command() -> None:
+    """``python -m ur3hanoi`` (what bench scripts use, no ``ur3hanoi`` on PATH needed) runs the same parser."""
+    proc = subprocess.run([sys.executable, "-m", "ur3hanoi", "plan", "--blocks", "0"], capture_output=True,
+                          text=True, cwd=REPO, timeout=60)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("ur3hanoi plan: error: argument --blocks:"), proc.stderr

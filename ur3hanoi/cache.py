@@ -1,0 +1,155 @@
+"""The user's cache: data derived only from input files, computed once and kept on disk, keyed by their content.
+
+A cold ``ur3hanoi plan`` spends most of its clearance set-up reading and hulling the robot's URDF collision meshes,
+which depend on nothing but the robot model and the station's tool. this module keeps such data in
+:func:`cache_dir`:
+
+- **Key**: sha256 over the ur3hanoi version, the entry's kind, and every input's bytes (a file's content, never
+  its name or time stamp), so a changed station, URDF, mesh or ur3hanoi version is a new entry, never a stale one.
+  Kinds that hold a library's serialization put that library's version among their inputs.
+- **Entry**: ``<kind>-<key>.cache``, one header line (JSON: format, kind, key, length and sha256 of the payload)
+  then the payload in base64, written by the one atomic writer (:mod:`ur3hanoi.io.atomic`: temporary file and
+  rename, under a lock). A reader sees a whole entry or none; two processes that miss at once both build, and
+  the second one finds the first's entry under the lock and leaves it.
+- **Never an error**: an entry that is unreadable, truncated, corrupt or foreign (any header, length or digest
+  mismatch) is ignored and rebuilt, and a cache folder that cannot be created or written only costs the rebuild.
+  Nothing reaches a deserializer unless its digest matches what was written.
+"""
+
+from __future__ import annotations
+
+import base64
+import binascii
+import contextlib
+import hashlib
+import json
+import os
+import re
+import tempfile
+from collections.abc import Callable, Iterable, Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ur3hanoi import __version__
+from ur3hanoi.errors import Ur3HanoiError
+
+if TYPE_CHECKING:
+    import pinocchio as pin
+
+    from ur3hanoi.robot import Ur3Model
+
+FORMAT = 1
+"""Version of the entry layout (header fields, base64 payload)."""
+
+def cache_dir() -> Path:
+    """``$XDG_CACHE_HOME/ur3hanoi`` (``~/.cache/ur3hanoi`` when XDG_CACHE_HOME is unset or empty)."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "ur3hanoi"
+
+
+def content_key(kind: str, inputs: Iterable[bytes]) -> str:
+    """sha256 (hex) of the ur3hanoi version, ``kind`` and each input, every item length-prefixed (so no two
+    different input lists hash the same bytes)."""
+    h = hashlib.sha256()
+    for item in (__version__.encode(), kind.encode(), *inputs):
+        h.update(len(item).to_bytes(8, "little"))
+        h.update(item)
+    return h.hexdigest()
+
+
+def entry_path(kind: str, key: str) -> Path:
+    """The file of one entry."""
+    return cache_dir() / f"{kind}-{key}.cache"
+
+
+def _header(kind: str, key: str, payload: bytes) -> dict[str, object]:
+    return {"format": FORMAT, "kind": kind, "key": key, "length": len(payload),
+            "sha256": hashlib.sha256(payload).hexdigest()}
+
+
+def load(kind: str, key: str) -> bytes | None:
+    """The payload of entry (``kind``, ``key``), or None when it is missing, unreadable or fails any check."""
+    try:
+        with open(entry_path(kind, key), "rb") as f:
+            head = f.readline(4096)
+            body = f.read()
+        header = json.loads(head)
+        payload = base64.b64decode(body.rstrip(b"\n"), validate=True)
+    except (OSError, ValueError, binascii.Error):  # json and base64 errors are ValueErrors
+        return None
+    if header != _header(kind, key, payload):
+        return None
+    return payload
+
+
+def store(kind: str, key: str, payload: bytes) -> bool:
+    """Write entry (``kind``, ``key``) unless a valid one is already there; False if the cache is not writable."""
+    from ur3hanoi.io.atomic import locked_output
+
+    path = entry_path(kind, key)
+    text = json.dumps(_header(kind, key, payload)) + "\n" + base64.b64encode(payload).decode("ascii") + "\n"
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with locked_output(path) as out:
+            if load(kind, key) != payload:  # another process may have written it while this one was building
+                out.write(text)
+    except (OSError, Ur3HanoiError):
+        return False
+    return True
+
+
+# ----------------------------------------------------------------------------------------- cached kinds
+
+
+COLLISION_GEOMETRY = "collision-geometry"
+"""Kind of the entries of :func:`collision_geometry`."""
+
+_MESH = re.compile(r'filename="([^"]+)"')
+_COLLISION = re.compile(r"<collision\b.*?</collision>", re.S)
+
+
+def collision_geometry(robot: Ur3Model, build: Callable[[], pin.GeometryModel]) -> pin.GeometryModel:
+    """The robot's collision ``GeometryModel`` as ``build`` makes it (URDF meshes read and hulled, ~0.1 s), from
+    the cache when the same URDF text (with its tool frame), collision meshes and Pinocchio/coal versions built it
+    before (loading is several times faster).
+
+    The payload is Pinocchio's binary serialization (``GeometryModel.saveToBinary``), loaded only after its
+    digest matched, into a model equal to a fresh build (same objects, same distances).
+    """
+    import coal
+    import pinocchio as pin
+
+    inputs = [f"pinocchio {pin.__version__}, coal {coal.__version__}".encode(), robot.urdf.encode()]
+    for block in _COLLISION.findall(robot.urdf):
+        for mesh in _MESH.findall(block):
+            try:
+                inputs.append(Path(mesh).read_bytes())
+            except OSError:  # the build reports a missing mesh; cache nothing then
+                return build()
+    key = content_key(COLLISION_GEOMETRY, inputs)
+    payload = load(COLLISION_GEOMETRY, key)
+    with _scratch_file() as path:
+        if payload is None:
+            gm = build()
+            gm.saveToBinary(str(path))
+            store(COLLISION_GEOMETRY, key, path.read_bytes())
+            return gm
+        path.write_bytes(payload)
+        gm = pin.GeometryModel()
+        try:
+            gm.loadFromBinary(str(path))
+        except RuntimeError:  # cannot happen for a digest-checked entry of these versions; rebuild all the same
+            return build()
+        return gm
+
+
+@contextlib.contextmanager
+def _scratch_file() -> Iterator[Path]:
+    """A private temporary file path (Pinocchio serializes to and from files only), removed afterwards."""
+    fd, name = tempfile.mkstemp(prefix="ur3hanoi-", suffix=".bin")
+    os.close(fd)
+    try:
+        yield Path(name)
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(name)
