@@ -4,12 +4,14 @@
 #  - Headless MuJoCo rendering (MUJOCO_GL=egl: --video/--frames and the notebooks): Mesa's EGL and GL drivers.
 #  - ROS 1 for `ur3hanoi ros-station` / `ros-solve` and their tests: Debian's roscore and pure-Python rospy,
 #    genpy and std_msgs (about 40 s). ur3hanoi.ros appends /usr/lib/python3/dist-packages to the venv's path.
+#  - Debian's chromium: the replay page's test opens it headless with the network off (tests/test_replay.py).
 set -euo pipefail
 missing=()
 ldconfig -p | grep -q 'libEGL.so.1 ' || missing+=(libegl1)
 ldconfig -p | grep -q 'libEGL_mesa.so.0 ' || missing+=(libegl-mesa0)
 [ -e /usr/lib/x86_64-linux-gnu/dri ] || [ -e /usr/lib/aarch64-linux-gnu/dri ] || missing+=(libgl1-mesa-dri)
 command -v roscore >/dev/null || missing+=(ros-core)
+command -v chromium >/dev/null || missing+=(chromium)
 for pkg in rospy genpy std_msgs; do
   [ -e "/usr/lib/python3/dist-packages/$pkg/__init__.py" ] || missing+=("python3-${pkg//_/-}")
 done

@@ -29,6 +29,9 @@ def add(sub: argparse._SubParsersAction) -> None:
                    help=f"suction dwell at each contact [s] in [{DWELL.lo:g}, {DWELL.hi:g}] (default 0.3)")
     p.add_argument("--csv", metavar="FILE",
                    help=f"write t,q1..q6,qd1..qd6,suction,move,phase samples to FILE ({SYMLINK_NOTE})")
+    p.add_argument("--html", metavar="FILE",
+                   help="write a replay page of the plan: one offline HTML file (3-D arm and blocks, timeline, move "
+                        "and suction state); FILE#t=12.5 opens at 12.5 s")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a summary")
     p.add_argument("--no-collision", action="store_true", help="skip the (slower) clearance checks")
     p.set_defaults(func=run)
@@ -44,6 +47,8 @@ def run(args: argparse.Namespace) -> int:
     inputs = [input_file(calibration_ref(args.calibration))]
     if args.csv:
         check_output(args.csv, inputs=inputs)  # fail before planning, not after
+    if args.html:
+        check_output(args.html, inputs=inputs)
     station = load_station(calibration_ref(args.calibration))
     n_blocks = station.n_heights if args.blocks is None else args.blocks
     check_blocks(n_blocks, station.n_heights, given=args.blocks is not None)
@@ -53,6 +58,14 @@ def run(args: argparse.Namespace) -> int:
     plan = plan_solve(station, args.start - 1, args.end - 1, n_blocks, config)
     if args.csv:
         atomic_write(args.csv, trajectory_csv(plan.trajectory), inputs=inputs)
+    html_size = None
+    if args.html:
+        from ur3hanoi.replay import write_plan_replay
+        from ur3hanoi.sim import build_task_scene
+
+        scene = build_task_scene(station, args.start - 1, n_blocks)
+        title = f"{station.name}: plan of {n_blocks} blocks, tower {args.start} -> {args.end}"
+        html_size = write_plan_replay(args.html, plan, scene, title, tuple(inputs))
     if args.json:
         print(json.dumps(plan.to_json_dict()))
         return 0
@@ -66,4 +79,6 @@ def run(args: argparse.Namespace) -> int:
           f"{100 * plan.motion_saving:.1f} % less motion time")
     print(f"{len(plan.trajectory.t)} samples at {plan.trajectory.rate_hz:g} Hz, speed {args.speed:g}; all limit and "
           "clearance checks passed" + (f"; wrote {shown(args.csv)}" if args.csv else ""))
+    if html_size is not None:
+        print(f"wrote the replay page {shown(args.html)} ({html_size / 1e6:.1f} MB)")
     return 0

@@ -97,6 +97,9 @@ def add(sub: argparse._SubParsersAction) -> None:
                    help="report progress on stderr also when it is not a terminal (plain lines every 10 %%; on by "
                         "default when rendering)")
     p.add_argument("--view", action="store_true", help="open MuJoCo's interactive viewer (needs a display)")
+    p.add_argument("--html", metavar="FILE",
+                   help="write a replay page: one offline HTML file (3-D arm and blocks, timeline, move and suction "
+                        "state, the halt on a fault); FILE#t=12.5 opens at 12.5 s")
     p.add_argument("--json", action="store_true", help="print one JSON object with the outcome on stdout")
     p.set_defaults(func=run)
 
@@ -170,6 +173,8 @@ def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
     from ur3hanoi.io.atomic import check_output
     from ur3hanoi.sim.render import check_video_path
 
+    if args.html:
+        check_output(args.html, inputs=inputs)
     if args.video:
         check_output(args.video, inputs=inputs)  # first: "it is a directory" says more than "no extension"
         check_video_path(args.video)
@@ -283,8 +288,14 @@ def run(args: argparse.Namespace) -> int:
                                      video=Path(args.video) if args.video else None, camera=camera,
                                      t_from=args.t_from or 0.0, t_to=args.t_to)
         progress = _progress_sink(args, sink if args.video or args.frames else None)
+        frames = sink
+        if args.html:
+            from ur3hanoi.replay import REPLAY_FPS, PoseRecorder, SinkTee
+
+            replay = PoseRecorder(scene.model, REPLAY_FPS)
+            frames = replay if sink is None else SinkTee([sink, replay])  # type: ignore[list-item]
         try:
-            result = run_plan(plan, faults, config, frames=sink, progress=progress,  # type: ignore[arg-type]
+            result = run_plan(plan, faults, config, frames=frames, progress=progress,  # type: ignore[arg-type]
                               scene=scene, realtime=args.view)
         except SuctionFaultError as exc:
             # A halted run still has a result to report (the final block positions, the halt).
@@ -295,6 +306,14 @@ def run(args: argparse.Namespace) -> int:
         if sink is not None:
             sink.close()  # type: ignore[attr-defined]
 
+    html_size = None
+    if args.html:
+        from ur3hanoi.replay import write_run_replay
+
+        following = f", following {args.table}:{args.key}" if args.table is not None else ""
+        title = (f"{station.name}: {n_blocks} blocks, tower {start + 1} -> {end + 1}{following}: {result.status} "
+                 f"({result.moves_completed}/{result.moves_total} moves)")
+        html_size = write_run_replay(args.html, plan, scene, replay, result, title, tuple(inputs))
     if args.json:
         out = result.as_dict()
         if args.table is not None:
@@ -315,6 +334,8 @@ def run(args: argparse.Namespace) -> int:
               f"{'on' if result.suction_on_at_end else 'off'}, {'at' if result.at_home_at_end else 'not at'} home")
         if args.video or args.frames:
             print(f"  wrote {sink.count} frames to {shown(args.video or args.frames)}")  # type: ignore[union-attr]
+        if html_size is not None:
+            print(f"  wrote the replay page {shown(args.html)} ({html_size / 1e6:.1f} MB)")
     if fault is not None:
         print(f"ur3hanoi: error: {' '.join(str(fault).split())}", file=sys.stderr)
         return exit_codes.exit_code_for(fault)

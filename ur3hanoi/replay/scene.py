@@ -65,7 +65,7 @@ def _mesh_geometry(model: mujoco.MjModel, mesh: int) -> IndexedMesh:
 
 
 def _hex(rgba: np.ndarray) -> int:
-    r, g, b = (int(round(255 * float(np.clip(c, 0.0, 1.0)))) for c in rgba[:3])
+    r, g, b = (round(255 * float(np.clip(c, 0.0, 1.0))) for c in rgba[:3])
     return (r << 16) | (g << 8) | b
 
 
