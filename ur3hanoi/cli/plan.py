@@ -32,6 +32,9 @@ def add(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--html", metavar="FILE",
                    help="write a replay page of the plan: one offline HTML file (3-D arm and blocks, timeline, move "
                         "and suction state); FILE#t=12.5 opens at 12.5 s")
+    p.add_argument("--plot", metavar="FILE",
+                   help="draw joint positions and speeds against time with the limits, phases shaded, into FILE "
+                        "(.png, .svg or .pdf; needs the plot extra)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of a summary")
     p.add_argument("--no-collision", action="store_true", help="skip the (slower) clearance checks")
     p.set_defaults(func=run)
@@ -49,6 +52,11 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.csv, inputs=inputs)  # fail before planning, not after
     if args.html:
         check_output(args.html, inputs=inputs)
+    if args.plot:
+        from ur3hanoi.plots import check_plot_path, require_matplotlib
+
+        require_matplotlib()
+        check_plot_path(args.plot, tuple(inputs))
     station = load_station(calibration_ref(args.calibration))
     n_blocks = station.n_heights if args.blocks is None else args.blocks
     check_blocks(n_blocks, station.n_heights, given=args.blocks is not None)
@@ -58,6 +66,11 @@ def run(args: argparse.Namespace) -> int:
     plan = plan_solve(station, args.start - 1, args.end - 1, n_blocks, config)
     if args.csv:
         atomic_write(args.csv, trajectory_csv(plan.trajectory), inputs=inputs)
+    if args.plot:
+        from ur3hanoi.plots.plan import write_plan_plot
+
+        write_plan_plot(args.plot, plan, f"{station.name}: {n_blocks} blocks, tower {args.start} -> {args.end}, "
+                                         f"speed {args.speed:g}", tuple(inputs))
     html_size = None
     if args.html:
         from ur3hanoi.replay import write_plan_replay
@@ -81,4 +94,6 @@ def run(args: argparse.Namespace) -> int:
           "clearance checks passed" + (f"; wrote {shown(args.csv)}" if args.csv else ""))
     if html_size is not None:
         print(f"wrote the replay page {shown(args.html)} ({html_size / 1e6:.1f} MB)")
+    if args.plot:
+        print(f"wrote {shown(args.plot)}")
     return 0

@@ -49,7 +49,10 @@ class Output:
 
     def write(self, text: str) -> None:
         """Replace the file with ``text`` (UTF-8) atomically; see the module docstring."""
-        data = text.encode("utf-8")
+        self.write_bytes(text.encode("utf-8"))
+
+    def write_bytes(self, data: bytes) -> None:
+        """Replace the file with ``data`` atomically (pictures); see the module docstring."""
         try:
             fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp", dir=self.path.parent)
         except OSError as exc:
