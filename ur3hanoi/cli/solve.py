@@ -120,6 +120,16 @@ def prompt_tower(what: str, n_towers: int, exclude: int | None = None) -> int:
         print(f"Please just enter the character {label}\n")
 
 
+def render_workers() -> int:
+    """Processes rendering video frames: one per core the process may use (software GL renders one frame per
+    core at a time), at most 8."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    return max(1, min(8, cores))
+
+
 def _progress(fraction: float, label: str) -> None:
     width = 30
     filled = round(width * fraction)
@@ -286,7 +296,8 @@ def run(args: argparse.Namespace) -> int:
             camera = CameraConfig(width=width, height=height, fps=args.fps if args.fps is not None else default.fps)
             sink = OffscreenRecorder(station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
                                      video=Path(args.video) if args.video else None, camera=camera,
-                                     t_from=args.t_from or 0.0, t_to=args.t_to)
+                                     t_from=args.t_from or 0.0, t_to=args.t_to, workers=render_workers(),
+                                     progress=_progress_sink(args, None))
         progress = _progress_sink(args, sink if args.video or args.frames else None)
         frames = sink
         if args.html:
@@ -302,6 +313,8 @@ def run(args: argparse.Namespace) -> int:
             if exc.result is None:
                 raise
             result, fault = exc.result, exc
+        if isinstance(sink, OffscreenRecorder):
+            sink.render_pending()  # the frames, in parallel processes (progress per frame)
     finally:
         if sink is not None:
             sink.close()  # type: ignore[attr-defined]
