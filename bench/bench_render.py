@@ -79,7 +79,8 @@ def bench_frame(n: int) -> None:
         c0, t0 = cpu_self(), time.perf_counter()
         for _ in range(n):
             px = _draw(r, scene.data, camera, cam)
-        print(f"  frame, {label}: CPU {1e3 * (cpu_self() - c0) / n:.1f} ms (wall {1e3 * (time.perf_counter() - t0) / n:.1f} ms)")
+        cpu, wall = (cpu_self() - c0) / n, (time.perf_counter() - t0) / n
+        print(f"  frame, {label}: CPU {1e3 * cpu:.1f} ms (wall {1e3 * wall:.1f} ms)")
         r.close()
     import imageio_ffmpeg
 

@@ -51,6 +51,10 @@ here: building the parser must not load MuJoCo)."""
 PROGRESS_STEP = 0.1
 """Fraction of the run between two plain progress lines (when stderr is not a terminal)."""
 
+SIM_SHARE = 0.05
+"""Share of the progress bar given to simulating when the frames render afterwards in worker processes (the
+simulation takes about 1.5 s of a 30 s video job); the rest counts the frames rendered."""
+
 
 def add(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("solve", help="run the lab in MuJoCo: plan, execute with suction feedback, verify",
@@ -154,6 +158,20 @@ class _ProgressLines:
         frames = getattr(self.recorder, "count", None)
         extra = f", {frames} frames" if frames is not None else ""
         print(f"ur3hanoi solve: {100 * fraction:3.0f} % ({label}{extra})", file=sys.stderr, flush=True)
+
+
+def _phases(progress: ProgressFn | None) -> tuple[ProgressFn | None, ProgressFn | None]:
+    """One progress bar over two phases: the simulation (:data:`SIM_SHARE`), then the frames rendered."""
+    if progress is None:
+        return None, None
+
+    def simulating(fraction: float, label: str) -> None:
+        progress(SIM_SHARE * fraction, "simulated" if fraction >= 1.0 else label)
+
+    def rendering(fraction: float, label: str) -> None:
+        progress(SIM_SHARE + (1.0 - SIM_SHARE) * fraction, label)
+
+    return simulating, rendering
 
 
 def _progress_sink(args: argparse.Namespace, recorder: object | None) -> ProgressFn | None:
@@ -287,18 +305,24 @@ def run(args: argparse.Namespace) -> int:
     scene = build_task_scene(station, start, n_blocks, faults.remove_block, config.scene)
     sink: object | None = None
     fault: Ur3HanoiError | None = None
+    sim_progress: ProgressFn | None = None
+    render_progress: ProgressFn | None = None
     try:
         if args.view:
             sink = ViewerSink(scene.model, scene.data)
         elif args.video or args.frames:
+            workers = render_workers()
+            if workers > 1:  # frames render after the run, in worker processes: one bar over both phases
+                sim_progress, render_progress = _phases(_progress_sink(args, None))
             default = CameraConfig()
             width, height = args.size if args.size is not None else (default.width, default.height)
             camera = CameraConfig(width=width, height=height, fps=args.fps if args.fps is not None else default.fps)
             sink = OffscreenRecorder(station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
                                      video=Path(args.video) if args.video else None, camera=camera,
-                                     t_from=args.t_from or 0.0, t_to=args.t_to, workers=render_workers(),
-                                     progress=_progress_sink(args, None))
-        progress = _progress_sink(args, sink if args.video or args.frames else None)
+                                     t_from=args.t_from or 0.0, t_to=args.t_to, workers=workers,
+                                     progress=render_progress)
+        if sim_progress is None:
+            sim_progress = _progress_sink(args, sink if args.video or args.frames else None)
         frames = sink
         if args.html:
             from ur3hanoi.replay import REPLAY_FPS, PoseRecorder, SinkTee
@@ -306,7 +330,7 @@ def run(args: argparse.Namespace) -> int:
             replay = PoseRecorder(scene.model, REPLAY_FPS)
             frames = replay if sink is None else SinkTee([sink, replay])  # type: ignore[list-item]
         try:
-            result = run_plan(plan, faults, config, frames=frames, progress=progress,  # type: ignore[arg-type]
+            result = run_plan(plan, faults, config, frames=frames, progress=sim_progress,  # type: ignore[arg-type]
                               scene=scene, realtime=args.view)
         except SuctionFaultError as exc:
             # A halted run still has a result to report (the final block positions, the halt).

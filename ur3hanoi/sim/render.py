@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from collections.abc import Callable
 from typing import Any
 
 import mujoco
@@ -159,9 +159,10 @@ class OffscreenRecorder:
     is the number written. With ``workers`` > 1 the run only records each frame's joint state, and
     :meth:`render_pending` (called by the context manager on success) renders them in that many processes
     (``spawn``, one software-GL thread each), in order, reporting ``progress(fraction, label)`` per frame, while
-    ffmpeg encodes in its own process. Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo is imported.
-    A video needs ``imageio-ffmpeg`` (its wheel ships ffmpeg) and an extension of :data:`VIDEO_FORMATS`; PNG needs
-    only Pillow. Use as a context manager (it closes the renderer and finishes the file).
+    ffmpeg encodes in its own process. Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo
+    is imported. A video needs ``imageio-ffmpeg`` (its wheel ships ffmpeg) and an extension of
+    :data:`VIDEO_FORMATS`; PNG needs only Pillow. Use as a context manager (it closes the renderer and finishes
+    the file).
     """
 
     def __init__(self, station: Station, model: mujoco.MjModel, frames_dir: Path | None = None,
