@@ -12,7 +12,7 @@ from PIL import Image
 
 from ur3hanoi import cli
 
-PROGRESS_LINE = re.compile(r"ur3hanoi solve: +(\d+) % \((move \d+\/\d+|done|simulated|frame \d+\/\d+)(, (\d+) frames)?\)")
+PROGRESS_LINE = re.compile(r"ur3hanoi solve: +(\d+) % \((move \d+/\d+|done|simulated|frame \d+/\d+)(, (\d+) frames)?\)")
 
 
 def test_frames_in_a_window_at_a_size_and_rate(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
