@@ -5,7 +5,17 @@ from __future__ import annotations
 import argparse
 
 from ur3hanoi.cli.common import DEFAULT_CALIBRATION, SYMLINK_NOTE, calibration_ref, input_file, shown
-from ur3hanoi.cli.options import BLOCKS, DWELL, RATE, SPEED, TOWER, check_blocks, check_plan_size, option
+from ur3hanoi.cli.options import (
+    BLOCKS,
+    DWELL,
+    RATE,
+    SPEED,
+    check_blocks,
+    check_number,
+    check_plan_size,
+    option,
+    station_number,
+)
 
 
 def add(sub: argparse._SubParsersAction) -> None:
@@ -14,8 +24,10 @@ def add(sub: argparse._SubParsersAction) -> None:
                                    "from 1) and plan the whole motion with Ruckig under the UR3's limits "
                                    "(pass-through above the towers, vertical approach within 2 mm), checked for "
                                    "joint limits, velocity/acceleration/jerk and clearances.")
-    p.add_argument("--start", type=option(TOWER), required=True, help="start tower (1-based)")
-    p.add_argument("--end", type=option(TOWER), required=True, help="end tower (1-based)")
+    p.add_argument("--start", type=station_number("a tower number"), required=True,
+                   help="start tower (1-based, 1..the station's towers)")
+    p.add_argument("--end", type=station_number("a tower number"), required=True,
+                   help="end tower (1-based, 1..the station's towers)")
     p.add_argument("--blocks", type=option(BLOCKS), default=None,
                    help=f"{BLOCKS.expected()} (default: the grid's heights)")
     p.add_argument("--calibration", default=None, metavar="CAL",
@@ -58,6 +70,8 @@ def run(args: argparse.Namespace) -> int:
         require_matplotlib()
         check_plot_path(args.plot, tuple(inputs))
     station = load_station(calibration_ref(args.calibration))
+    for name, value in (("--start", args.start), ("--end", args.end)):
+        check_number(name, value, station.n_towers, "a tower", f"{station.name} has {station.n_towers} towers")
     n_blocks = station.n_heights if args.blocks is None else args.blocks
     check_blocks(n_blocks, station.n_heights, given=args.blocks is not None)
     check_plan_size(n_blocks, args.speed, args.dwell, args.rate)

@@ -24,19 +24,18 @@ from ur3hanoi.cli.common import DEFAULT_CALIBRATION, calibration_ref, input_file
 from ur3hanoi.cli.options import (
     BLOCKS,
     FPS,
-    HEIGHT,
-    MOVE,
     SEED,
     SIM_TIME,
     SPEED,
-    TOWER,
     UsageError,
     check_blocks,
     check_faults,
+    check_number,
     check_plan_size,
     check_window,
     image_size,
     option,
+    station_number,
 )
 from ur3hanoi.errors import OutputError, SuctionFaultError, Ur3HanoiError, printable
 from ur3hanoi.labfile import TABLE_KEYS
@@ -63,8 +62,10 @@ def add(sub: argparse._SubParsersAction) -> None:
                                    "program halts like the lab's (suction off, arm home, exit 3) when a block is "
                                    "missing or dropped. Towers, heights and moves are numbered from 1. Without "
                                    "--start/--end it prompts on a terminal like the lab program.")
-    p.add_argument("--start", type=option(TOWER), metavar="S", help="start tower (1-based)")
-    p.add_argument("--end", type=option(TOWER), metavar="E", help="destination tower (1-based)")
+    p.add_argument("--start", type=station_number("a tower number"), metavar="S",
+                   help="start tower (1-based, 1..the station's towers)")
+    p.add_argument("--end", type=station_number("a tower number"), metavar="E",
+                   help="destination tower (1-based, 1..the station's towers)")
     p.add_argument("--blocks", type=option(BLOCKS), default=None, metavar="N",
                    help=f"{BLOCKS.expected()} (default: the grid's heights, 3 on the lab)")
     p.add_argument("--calibration", default=None, metavar="CAL",
@@ -75,9 +76,9 @@ def add(sub: argparse._SubParsersAction) -> None:
                         "joint moves between its entries like the lab program; a missed block halts (exit 3) "
                         "naming the table entry")
     p.add_argument("--key", choices=TABLE_KEYS, help="the table key to follow (with --table)")
-    p.add_argument("--remove-block", type=option(HEIGHT), metavar="H",
+    p.add_argument("--remove-block", type=station_number("a height"), metavar="H",
                    help="fault injection: spawn without the block at height H (1-based), like lab2_spawn.py")
-    p.add_argument("--drop-during-move", type=option(MOVE), metavar="M",
+    p.add_argument("--drop-during-move", type=station_number("a move number"), metavar="M",
                    help="fault injection: the suction loses its block in the middle of move M's carry (1-based)")
     p.add_argument("--speed", type=option(SPEED), default=1.0, metavar="F",
                    help=f"fraction of the joint speed/acceleration/jerk limits, in [{SPEED.lo:g}, {SPEED.hi:g}] "
@@ -204,8 +205,22 @@ def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
     if args.html:
         check_output(args.html, inputs=inputs)
     if args.video:
-        check_output(args.video, inputs=inputs)  # first: "it is a directory" says more than "no extension"
+        video = Path(args.video)
+        if video.is_dir():
+            check_output(args.video, inputs=inputs)  # "it is a directory" says more than "no extension"
         check_video_path(args.video)
+        try:
+            import imageio_ffmpeg  # noqa: F401  (the "video" extra)
+        except ImportError:
+            raise UsageError("--video needs the video extra (imageio-ffmpeg, which ships ffmpeg): pip install "
+                             "'ur3hanoi[video]'; or write PNG frames with --frames DIR") from None
+        try:  # like --frames DIR: a missing output folder is created (README: --video out/run.mp4)
+            video.parent.mkdir(parents=True, exist_ok=True)
+        except (OSError, ValueError) as exc:
+            problem = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+            raise OutputError(f"cannot write the video {printable(args.video)}: its folder cannot be created: "
+                              f"{problem}") from None
+        check_output(args.video, inputs=inputs)
     if args.frames:
         try:
             Path(args.frames).mkdir(parents=True, exist_ok=True)
@@ -216,8 +231,11 @@ def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
             raise OutputError(f"cannot write frames into {printable(args.frames)}: the directory is not writable")
 
 
-def _towers(args: argparse.Namespace, n_towers: int) -> tuple[int, int]:
+def _towers(args: argparse.Namespace, n_towers: int, station_name: str = "") -> tuple[int, int]:
     """Start and end tower, 0-based: from the options, or prompted for on a terminal."""
+    why = f"{station_name} has {n_towers} towers" if station_name else ""
+    check_number("--start", args.start, n_towers, "a tower", why)
+    check_number("--end", args.end, n_towers, "a tower", why)
     if args.start is not None and args.end is not None:
         return args.start - 1, args.end - 1
     if not sys.stdin.isatty():
@@ -266,7 +284,7 @@ def run(args: argparse.Namespace) -> int:
     n_towers = station.n_towers
     n_blocks = station.n_heights if args.blocks is None else args.blocks
     check_blocks(n_blocks, station.n_heights, given=args.blocks is not None)
-    start, end = _towers(args, n_towers)
+    start, end = _towers(args, n_towers, station.name)
     validate_instance(n_blocks, start, end, n_towers, station.n_heights)
     check_faults(args.remove_block, args.drop_during_move, n_blocks)
     plan_config = PlanConfig(speed=args.speed)

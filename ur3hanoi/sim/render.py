@@ -195,8 +195,9 @@ class OffscreenRecorder:
 
                 imageio_ffmpeg.get_ffmpeg_exe()
             except ImportError:
-                raise SimulationError(f"cannot write the video {printable(video)}: it needs the package "
-                                      "imageio-ffmpeg (not installed); write PNG frames (frames_dir) instead") from None
+                raise SimulationError(f"cannot write the video {printable(video)}: it needs imageio-ffmpeg (not "
+                                      "installed): pip install 'ur3hanoi[video]'; or write PNG frames (frames_dir)"
+                                      ) from None
             except RuntimeError as exc:  # no ffmpeg binary found
                 raise SimulationError(f"cannot write the video {printable(video)}: {exc}") from None
             self._video_format = fmt
