@@ -103,7 +103,7 @@ def test_run_timeline_names_the_halt_and_stops_counting_moves() -> None:
     tl = timeline_of_run(plan, result, rec.track().t, "t")
     drops = [e.t for e in result.feedback_events if e.kind == "dropped"]
     assert tl.fault_t == pytest.approx(min(drops), abs=1e-9)
-    assert tl.fault_message is not None and "move 4/7" in tl.fault_message
+    assert tl.fault_message is not None and "move 4/7" in tl.fault_message and tl.fault_move == DROP_MOVE
     before, after = tl.t < tl.fault_t, tl.t >= tl.fault_t
     assert set(tl.move[before].tolist()) == {0, 1, 2, 3}
     assert set(tl.move[after].tolist()) == {-1}
@@ -239,6 +239,8 @@ def test_browser_overlay_shows_the_moment_named_in_the_address(browser_shots, tm
     assert 'id="ur3-move">move 3/7: block 3 (red): tower 3 height 1 -&gt; tower 2 height 2<' in dom
     assert re.search(r'id="ur3-fault"[^>]*>halted at 17\.\d\d s: suction fault in move 4/7', dom)
     assert 'id="ur3-play">Play<' in dom  # opened paused at the named moment
+    after = _browse(f"{page.as_uri()}#t=18", tmp_path, "dom18", "dump").stdout
+    assert 'id="ur3-move">halted in move 4/7: the arm stops' in after
 
 
 def test_plan_replay_writes_a_page(tmp_path: Path) -> None:

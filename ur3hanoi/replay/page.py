@@ -84,7 +84,10 @@ OVERLAY_JS = r"""
     $("ur3-time").textContent = t.toFixed(2) + " s / " + dur.toFixed(2) + " s";
     slider.value = t;
     let what;
-    if (T.fault && t >= T.fault.t) what = "halted: suction off, arm returning home";
+    if (T.fault && t >= T.fault.t) {
+      what = "halted" + (T.fault.move ? " in move " + T.fault.move + "/" + T.moves.length : "") +
+          ": the arm stops, the suction goes off, the arm returns home";
+    }
     else if (m >= 0) what = "move " + (m + 1) + "/" + T.moves.length + ": " + T.moves[m];
     else if (T.t[i] < 1e-9 || T.move.slice(0, i).every((v) => v < 0)) what = "at the start";
     else what = "returning home";

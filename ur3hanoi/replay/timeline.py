@@ -30,7 +30,8 @@ class Timeline:
         suction: (F,) suction on (the valve, as ``AIN0`` shows it in a run; as commanded in a plan).
         held: (F,) a block is held (``DIGIN`` bit 0 in a run; as planned in a plan).
         moves: one line per move, 1-based ("block 3 (red): tower 1 height 3 -> tower 3 height 1").
-        fault_t: sim time [s] the halt began (None: no fault); fault_message: the run's error line.
+        fault_t: sim time [s] the halt began (None: no fault); fault_message: the run's error line;
+            fault_move: the 0-based move it halted in.
         title: the page's heading.
     """
 
@@ -42,6 +43,7 @@ class Timeline:
     title: str
     fault_t: float | None = None
     fault_message: str | None = None
+    fault_move: int | None = None
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -52,7 +54,9 @@ class Timeline:
             "suction": [int(v) for v in self.suction],
             "held": [int(v) for v in self.held],
             "moves": list(self.moves),
-            "fault": None if self.fault_t is None else {"t": round(self.fault_t, 4), "message": self.fault_message},
+            "fault": None if self.fault_t is None else {
+                "t": round(self.fault_t, 4), "message": self.fault_message,
+                "move": None if self.fault_move is None else self.fault_move + 1},
         }
 
 
@@ -104,4 +108,5 @@ def timeline_of_run(plan: Plan, result: SimResult, t: FloatArray, title: str,
         move = np.where(t >= fault_t, -1, move)
     message = None if result.error is None else " ".join(result.error.split())
     return Timeline(t=t, move=move, suction=suction_on, held=held, moves=move_labels(plan), title=title,
-                    fault_t=fault_t, fault_message=message if fault_t is not None else None)
+                    fault_t=fault_t, fault_message=message if fault_t is not None else None,
+                    fault_move=result.fault_move if fault_t is not None else None)
