@@ -248,3 +248,35 @@ def test_plan_replay_writes_a_page(tmp_path: Path) -> None:
     out = tmp_path / "plan.html"
     size = write_plan_replay(out, plan, build_task_scene(STATIONS["lab_sim"], 0, 3), "plan")
     assert out.stat().st_size == size < 15e6
+
+
+# ------------------------------------------------------------------------------------------------ the commands
+
+
+def test_cli_solve_and_plan_write_a_page(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from ur3hanoi.cli import main
+
+    assert main(["solve", "--start", "1", "--end", "2", "--blocks", "1", "--html", str(tmp_path / "s.html")]) == 0
+    assert "wrote the replay page" in capsys.readouterr().out
+    assert main(["solve", "--start", "1", "--end", "2", "--blocks", "2", "--remove-block", "1",
+                 "--html", str(tmp_path / "f.html")]) == 3
+    text = (tmp_path / "f.html").read_text()
+    data = json.loads(re.search(r"var UR3_TIMELINE = (\{.*?\});\n", text).group(1))  # type: ignore[union-attr]
+    assert data["fault"]["move"] == 2 and "is missing" in data["fault"]["message"]  # block 1 is picked in move 2
+    assert main(["plan", "--start", "1", "--end", "2", "--blocks", "1", "--no-collision",
+                 "--html", str(tmp_path / "p.html")]) == 0
+    assert (tmp_path / "p.html").stat().st_size > 1e6
+
+
+def test_cli_html_without_meshcat_names_the_extra(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    import sys
+
+    from ur3hanoi.cli import main
+
+    monkeypatch.setitem(sys.modules, "meshcat", None)
+    assert main(["plan", "--start", "1", "--end", "3", "--html", str(tmp_path / "p.html")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["ur3hanoi: error: --html needs meshcat (its three.js viewer), which is not installed: pip install "
+                   "'ur3hanoi[replay]'"]
+    assert not (tmp_path / "p.html").exists()

@@ -26,3 +26,14 @@ def input_file(ref: str) -> Path:
 def shown(path: Any) -> str:
     """A user-given path as printed on the terminal (control characters escaped)."""
     return printable(path, 4096)
+
+
+def require_replay() -> None:
+    """``--html`` needs meshcat's viewer (the ``replay`` extra; placo installs it too): one line naming the extra."""
+    import importlib.util
+
+    from ur3hanoi.cli.options import UsageError
+
+    if importlib.util.find_spec("meshcat") is None or importlib.util.find_spec("umsgpack") is None:
+        raise UsageError("--html needs meshcat (its three.js viewer), which is not installed: pip install "
+                         "'ur3hanoi[replay]'")

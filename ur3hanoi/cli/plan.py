@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from ur3hanoi.cli.common import DEFAULT_CALIBRATION, SYMLINK_NOTE, calibration_ref, input_file, shown
+from ur3hanoi.cli.common import (
+    DEFAULT_CALIBRATION,
+    SYMLINK_NOTE,
+    calibration_ref,
+    input_file,
+    require_replay,
+    shown,
+)
 from ur3hanoi.cli.options import (
     BLOCKS,
     DWELL,
@@ -63,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
     if args.csv:
         check_output(args.csv, inputs=inputs)  # fail before planning, not after
     if args.html:
+        require_replay()
         check_output(args.html, inputs=inputs)
     if args.plot:
         from ur3hanoi.plots import check_plot_path, require_matplotlib

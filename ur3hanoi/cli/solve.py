@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ur3hanoi.cli import exit_codes
-from ur3hanoi.cli.common import DEFAULT_CALIBRATION, calibration_ref, input_file, shown
+from ur3hanoi.cli.common import DEFAULT_CALIBRATION, calibration_ref, input_file, require_replay, shown
 from ur3hanoi.cli.options import (
     BLOCKS,
     FPS,
@@ -203,6 +203,7 @@ def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
     from ur3hanoi.sim.render import check_video_path
 
     if args.html:
+        require_replay()
         check_output(args.html, inputs=inputs)
     if args.video:
         video = Path(args.video)
