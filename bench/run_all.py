@@ -16,7 +16,7 @@ from pathlib import Path
 
 BENCH = Path(__file__).resolve().parent
 REPO = BENCH.parent
-SCRIPTS = ("bench_ik.py", "bench_plan.py", "bench_sim.py", "bench_ros.py")
+SCRIPTS = ("bench_ik.py", "bench_plan.py", "bench_sim.py", "bench_ros.py", "bench_render.py")
 PACKAGES = ("pin", "placo", "ruckig", "mujoco", "numpy", "example-robot-data")
 
 
