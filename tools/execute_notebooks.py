@@ -21,10 +21,15 @@ REPO = Path(__file__).resolve().parents[1]
 def execute(nb: nbformat.NotebookNode, directory: Path) -> nbformat.NotebookNode:
     """Run every cell of ``nb`` in a fresh kernel (matplotlib's inline backend: figures become PNG outputs)."""
     os.environ.setdefault("MUJOCO_GL", "egl")
-    os.environ.pop("MPLBACKEND", None)  # the kernel's inline backend, not Agg: the figures are the outputs
-    client = NotebookClient(nb, timeout=900, kernel_name="python3", record_timing=False,
-                            resources={"metadata": {"path": str(directory)}})
-    client.execute()
+    # The kernel's inline backend, not Agg: the figures are the outputs (the caller's setting is restored).
+    saved = os.environ.pop("MPLBACKEND", None)
+    try:
+        client = NotebookClient(nb, timeout=900, kernel_name="python3", record_timing=False,
+                                resources={"metadata": {"path": str(directory)}})
+        client.execute()
+    finally:
+        if saved is not None:
+            os.environ["MPLBACKEND"] = saved
     return nb
 
 
