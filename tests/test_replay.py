@@ -280,3 +280,13 @@ def test_cli_html_without_meshcat_names_the_extra(tmp_path: Path, capsys: pytest
     assert err == ["ur3hanoi: error: --html needs meshcat (its three.js viewer), which is not installed: pip install "
                    "'ur3hanoi[replay]'"]
     assert not (tmp_path / "p.html").exists()
+
+
+def test_the_same_plan_gives_the_same_page(tmp_path: Path) -> None:
+    plan = planned("lab_sim", 0, 2)
+    pages = []
+    for i in range(2):
+        out = tmp_path / f"p{i}.html"
+        write_plan_replay(out, plan, build_task_scene(STATIONS["lab_sim"], 0, 3), "plan", fps=5.0)
+        pages.append(out.read_bytes())
+    assert pages[0] == pages[1]

@@ -8,6 +8,8 @@ sends them), replayed by meshcat's three.js viewer in the page (:mod:`ur3hanoi.r
 
 from __future__ import annotations
 
+import itertools
+from collections.abc import Iterator
 from typing import Any
 
 import mujoco
@@ -30,6 +32,8 @@ POSE_TOLERANCE = 1e-7
 interpolation redraws it exactly): a block at rest costs two keyframes, not one per frame."""
 
 Command = dict[str, Any]
+
+_UUIDS = itertools.count()
 
 
 class IndexedMesh(mg.Geometry):
@@ -129,11 +133,15 @@ def _keep(values: FloatArray) -> np.ndarray:
     return keep
 
 
-def _pack(cmd: Any) -> bytes:
+def _pack(cmd: Any, ids: Iterator[int] | None = None) -> bytes:
+    if isinstance(cmd, SetObject):
+        # meshcat names objects by time-based uuid1: number them instead, so a run gives the same page every time.
+        for element in (cmd.object, cmd.object.geometry, cmd.object.material):
+            element.uuid = f"ur3hanoi-{next(ids if ids is not None else _UUIDS)}"
     return bytes(umsgpack.packb(cmd.lower() if hasattr(cmd, "lower") else cmd))
 
 
-def _tower_pads(station: Station) -> list[bytes]:
+def _tower_pads(station: Station, ids: Iterator[int]) -> list[bytes]:
     """A thin light pad under every slot's bottom face, so empty towers show where they are."""
     out = []
     centers = slot_centers(station)
@@ -143,7 +151,7 @@ def _tower_pads(station: Station) -> list[bytes]:
             c = centers[t, h]
             path = ROOT.append(f"towers/t{t + 1}h{h + 1}")
             out.append(_pack(SetObject(mg.Box([1.3 * s, 1.3 * s, 0.001]),
-                                       mg.MeshLambertMaterial(color=0xDDDDDD), path)))
+                                       mg.MeshLambertMaterial(color=0xDDDDDD), path), ids))
             T = np.eye(4)
             T[:3, 3] = [c[0], c[1], c[2] - 0.5 * s + 0.0006]
             out.append(_pack(SetTransform(T, path)))
@@ -171,7 +179,9 @@ def camera_commands(station: Station, distance: float = 1.1, azimuth_deg: float 
 
 
 def scene_commands(model: mujoco.MjModel, station: Station, track: PoseTrack) -> list[bytes]:
-    """Packed meshcat commands: objects, their first pose, the camera, and the animation (not started)."""
+    """Packed meshcat commands: objects, their first pose, the camera, and the animation (not started). The same
+    inputs give the same bytes."""
+    ids = itertools.count()
     cmds: list[bytes] = []
     clips = []
     for i, g in enumerate(track.geoms):
@@ -181,7 +191,7 @@ def scene_commands(model: mujoco.MjModel, station: Station, track: PoseTrack) ->
         for j, (shape, T_geom_shape) in enumerate(_shapes(model, int(g))):
             material = mg.MeshPhongMaterial(color=_hex(rgba), opacity=float(rgba[3]), transparent=bool(rgba[3] < 1))
             path = node.append(f"shape{j}")
-            cmds.append(_pack(SetObject(shape, material, path)))
+            cmds.append(_pack(SetObject(shape, material, path), ids))
             cmds.append(_pack(SetTransform(T_geom_shape, path)))
         cmds.append(_pack(SetTransform(_matrix(track.pos[0, i], track.mat[0, i]), node)))
         pos = track.pos[:, i]
@@ -197,7 +207,7 @@ def scene_commands(model: mujoco.MjModel, station: Station, track: PoseTrack) ->
             {"name": ".quaternion", "type": "quaternion", "times": times.tolist(),
              "values": quat[keep].reshape(-1).tolist()},
         ]}})
-    cmds += _tower_pads(station)
+    cmds += _tower_pads(station, ids)
     cmds += camera_commands(station)
     if clips:
         cmds.append(_pack({"type": "set_animation", "path": "", "animations": clips,
