@@ -218,6 +218,14 @@ class OffscreenRecorder:
             raise SimulationError(f"offscreen rendering is unavailable ({exc}); on a headless machine set "
                                   "MUJOCO_GL=egl (libegl1) or MUJOCO_GL=osmesa (libosmesa6)") from None
         self.camera = _free_camera(station, cam)
+        self._pool: Any = None
+        if self.workers > 1:
+            # Start the rendering processes now: they import MuJoCo and make their GL contexts while the run is
+            # simulated.
+            import multiprocessing
+
+            ctx = multiprocessing.get_context("spawn")  # a fresh GL context per process, nothing inherited
+            self._pool = ctx.Pool(self.workers, initializer=_init_worker, initargs=(model, self.lookat, cam))
 
     def _open_writer(self) -> Any:
         """Start ffmpeg on the first frame: a run with no frame in the window leaves no (invalid) video behind."""
@@ -265,24 +273,23 @@ class OffscreenRecorder:
         """Render the frames recorded for the worker processes, in order, streaming them into the video (ffmpeg
         encodes in its own process meanwhile) or the frames directory; reports progress per frame."""
         states, self._states = self._states, []
-        if not states:
+        if not states or self._pool is None:
             return
-        import multiprocessing
-
         n = len(states)
-        ctx = multiprocessing.get_context("spawn")  # a fresh GL context per process, nothing inherited
-        workers = min(self.workers, n)
         every = max(1, n // 100)
-        with ctx.Pool(workers, initializer=_init_worker, initargs=(self.model, self.lookat, self.cam_cfg)) as pool:
-            for i, pixels in enumerate(pool.imap(_render_state, states, chunksize=2), start=1):
-                self._write(pixels)
-                if self.progress is not None and (i % every == 0 or i == n):
-                    self.progress(i / n, f"frame {i}/{n}")
+        for i, pixels in enumerate(self._pool.imap(_render_state, states, chunksize=2), start=1):
+            self._write(pixels)
+            if self.progress is not None and (i % every == 0 or i == n):
+                self.progress(i / n, f"frame {i}/{n}")
 
     def close(self) -> None:
         """Release the renderer and finish the file; frames recorded for the workers and not yet rendered
         (:meth:`render_pending`) are dropped (an interrupted run)."""
         self._states = []
+        if self._pool is not None:
+            pool, self._pool = self._pool, None
+            pool.terminate()
+            pool.join()
         self.renderer.close()
         self._close_writer()
 
