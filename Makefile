@@ -6,7 +6,7 @@ VENV ?= .venv
 STAMP := $(VENV)/.installed
 export MUJOCO_GL ?= egl
 
-.PHONY: solve test venv lint bench tables docs clean
+.PHONY: solve test venv lint bench tables docs clean lab
 
 $(STAMP): pyproject.toml requirements.lock tools/ensure-system-deps.sh
 	@$(PY) -c 'import sys; ok = (3, 11) <= sys.version_info[:2] <= (3, 13); ok or print(f"ur3hanoi: error: Python {sys.version.split()[0]} ($(PY)) is not supported: use Python 3.11, 3.12 or 3.13, e.g. make PY=python3.12"); sys.exit(not ok)'
@@ -37,6 +37,11 @@ lint: $(STAMP)
 
 bench: $(STAMP)
 	$(VENV)/bin/python bench/run_all.py
+
+# The notebooks in JupyterLab (installs the `notebooks` extra into the venv on first use).
+lab: $(STAMP)
+	$(VENV)/bin/pip install -q -c requirements.lock -e '.[notebooks]'
+	$(VENV)/bin/jupyter lab notebooks/
 
 clean:
 	rm -rf $(VENV)

@@ -110,7 +110,7 @@ def test_missing_calibration_exits_2(tmp_path: Path, capsys: pytest.CaptureFixtu
 def test_bad_key_is_a_one_line_usage_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["tables", str(LAB_SIM), "--key", "gazebo", "-o", str(tmp_path / "o.yaml")]) == 2
     err = _one_error_line(capsys.readouterr().err)
-    assert err.startswith("ur3hanoi tables: error: argument --key: invalid choice: 'gazebo'")
+    assert err.startswith("ur3hanoi: error: argument --key: invalid choice: 'gazebo'")
     assert err.rstrip().endswith("(see ur3hanoi tables --help)")
 
 
@@ -165,20 +165,32 @@ BAD_OPTIONS = [
     (["plan", "--start", "1", "--end", "3", "--speed", "1.5"], "--speed", SPEED_RANGE),
     (["plan", "--start", "1", "--end", "3", "--dwell", "1e300"], "--dwell", "a dwell time [s] in [0, 10]"),
     (["plan", "--start", "1", "--end", "3", "--dwell", "-0.1"], "--dwell", "a dwell time [s] in [0, 10]"),
-    (["plan", "--start", "0", "--end", "3"], "--start", "a tower number (1-based) in [1, 10]"),
     (["plan", "--start", "1", "--end", "3", "--blocks", "11"], "--blocks", "a number of blocks in [1, 10]"),
     (["plan", "--start", "1", "--end", "3", "--blocks", "2.5"], "--blocks", "a number of blocks in [1, 10]"),
     (["solve", "--start", "1", "--end", "3", "--seed", "-1"], "--seed", "a seed in [0, 4294967295]"),
     (["solve", "--start", "1", "--end", "3", "--seed", str(2**32)], "--seed", "a seed in [0, 4294967295]"),
     (["solve", "--start", "1", "--end", "3", "--seed", "9" * 5000], "--seed", "a seed in [0, 4294967295]"),
     (["solve", "--start", "1", "--end", "3", "--speed", "0"], "--speed", SPEED_RANGE),
-    (["solve", "--start", "1", "--end", "3", "--remove-block", "0"], "--remove-block", "a height (1-based)"),
     (["solve", "--start", "1", "--end", "3", "--drop-during-move", "1e3"], "--drop-during-move", "a move number"),
     (["check-table", str(LAB_TABLE), "--key", "real_pos", "--calibration", "lab_real", "--tol-mm", "0"],
      "--tol-mm", "a position tolerance [mm] in (0, 1000]"),
     (["check-table", str(LAB_TABLE), "--key", "real_pos", "--calibration", "lab_real", "--tol-deg", "inf"],
      "--tol-deg", "an orientation tolerance [deg] in (0, 180]"),
 ]
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["plan", "--start", "0", "--end", "3"], "--start 0 is invalid: expected a tower 1..3 (lab_sim has 3 towers)"),
+    (["solve", "--start", "1", "--end", "4"], "--end 4 is invalid: expected a tower 1..3 (lab_sim has 3 towers)"),
+    (["solve", "--start", "1", "--end", "3", "--blocks", "2", "--remove-block", "3"],
+     "--remove-block 3 is invalid: expected a height 1..2 (2 blocks are spawned)"),
+    (["solve", "--start", "1", "--end", "3", "--blocks", "2", "--drop-during-move", "4"],
+     "--drop-during-move 4 is invalid: expected a move 1..3 (2 blocks take 3 moves)"),
+])
+def test_tower_height_and_move_ranges_are_the_stations(argv: list[str], message: str,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(argv) == 2
+    assert _one_error_line(capsys.readouterr().err) == f"ur3hanoi: error: {message}\n"
 
 
 @pytest.mark.parametrize(("argv", "flag", "expected"), BAD_OPTIONS, ids=[" ".join(a[-2:])[:30] for a, _, _ in
@@ -314,8 +326,8 @@ def test_unexpected_exception_is_one_line_exit_70(monkeypatch: pytest.MonkeyPatc
     argv = ["tables", "lab_sim", "--key", "sim_pos", "-o", str(tmp_path / "t.yaml")]
     assert main(argv) == 70
     err = _one_error_line(capsys.readouterr().err)
-    assert err == ("ur3hanoi tables: internal error: ZeroDivisionError: float division by zero (a bug: rerun with "
-                   "--debug for the traceback)\n")
+    assert err == ("ur3hanoi: error: internal error in ur3hanoi tables: ZeroDivisionError: float division by zero "
+                   "(a bug: rerun with --debug for the traceback)\n")
     with pytest.raises(ZeroDivisionError):
         main(["--debug", *argv])
     with pytest.raises(ZeroDivisionError):

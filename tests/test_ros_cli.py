@@ -46,7 +46,7 @@ def test_bad_arguments_exit_2_with_one_line(argv, message, capsys, monkeypatch):
 def test_bad_option_values_exit_2_with_one_line(argv, message, capsys):
     assert main(argv) == 2
     line = error_line(capsys)
-    assert line.startswith(f"ur3hanoi {argv[0]}: error: ") and message in line, line
+    assert line.startswith("ur3hanoi: error: ") and message in line and f"ur3hanoi {argv[0]} --help" in line, line
 
 
 def test_ros_solve_without_a_master_exits_2(capsys):

@@ -4,6 +4,7 @@
 #  - Headless MuJoCo rendering (MUJOCO_GL=egl: --video/--frames and the notebooks): Mesa's EGL and GL drivers.
 #  - ROS 1 for `ur3hanoi ros-station` / `ros-solve` and their tests: Debian's roscore and pure-Python rospy,
 #    genpy and std_msgs (about 40 s). ur3hanoi.ros appends /usr/lib/python3/dist-packages to the venv's path.
+#  - Debian's chromium: the replay page's test opens it headless with the network off (tests/test_replay.py).
 set -euo pipefail
 missing=()
 ldconfig -p | grep -q 'libEGL.so.1 ' || missing+=(libegl1)
@@ -16,6 +17,7 @@ command -v ip >/dev/null || missing+=(iproute2)
 command -v cmake >/dev/null || missing+=(cmake)
 command -v g++ >/dev/null || missing+=(g++)
 command -v make >/dev/null || missing+=(make)
+command -v chromium >/dev/null || missing+=(chromium)
 for pkg in rospy genpy std_msgs; do
   [ -e "/usr/lib/python3/dist-packages/$pkg/__init__.py" ] || missing+=("python3-${pkg//_/-}")
 done

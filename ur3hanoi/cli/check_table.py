@@ -41,6 +41,9 @@ def add(sub: argparse._SubParsersAction) -> None:
                         "a contact's axis is flagged over)")
     p.add_argument("--json", action="store_true",
                    help="print one JSON object: entries, suspects, warnings, fit (with --fit: the rule's thresholds)")
+    p.add_argument("--plot", metavar="FILE",
+                   help="draw the audit into FILE (.png, .svg or .pdf): top and side views of the recorded suction "
+                        "points against the reference towers, suspects marked and labelled (needs the plot extra)")
     p.set_defaults(func=run)
 
 
@@ -53,6 +56,13 @@ def run(args: argparse.Namespace) -> int:
 
     if args.base is not None and not args.fit:
         raise UsageError("--base is only used with --fit")
+    if args.plot:
+        from pathlib import Path
+
+        from ur3hanoi.plots import check_plot_path, require_matplotlib
+
+        require_matplotlib()
+        check_plot_path(args.plot, (Path(args.file),))  # before the audit's work
     table = read_recorded_table(args.file, args.key)
     if args.fit:
         base = load_station(args.base or default_base(args.key))
@@ -62,5 +72,11 @@ def run(args: argparse.Namespace) -> int:
         tol_mm = STRICT_MM if args.tol_mm is None else args.tol_mm
         tol_deg = STRICT_DEG if args.tol_deg is None else args.tol_deg
         report = check_against(table, station, tol_mm, tol_deg)
+    if args.plot:
+        from ur3hanoi.plots.audit import fitted_reference, write_audit_plot
+
+        grid = fitted_reference(table, base, args.tol_mm, args.tol_deg) if args.fit else station
+        write_audit_plot(args.plot, report, table, grid, title=f"{table.source}: {report.reference}",
+                         inputs=(Path(args.file),))
     print(json.dumps(report.to_json()) if args.json else report.text())
     return exit_codes.OVER_TOLERANCE if report.failed else exit_codes.OK

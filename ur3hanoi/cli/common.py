@@ -51,3 +51,14 @@ def add_suction_profile_option(p: Any) -> None:
                    help="suction feedback levels (DIGIN/AIN0 held, cup free, off): lab_sim = the course simulator's "
                         "(~1.9/1.45/1.05 V), real = a real station's (2.35/1.40/1.05 V); default: the "
                         "calibration's suction section (lab_sim without one)")
+
+
+def require_replay() -> None:
+    """``--html`` needs meshcat's viewer (the ``replay`` extra; placo installs it too): one line naming the extra."""
+    import importlib.util
+
+    from ur3hanoi.cli.options import UsageError
+
+    if importlib.util.find_spec("meshcat") is None or importlib.util.find_spec("umsgpack") is None:
+        raise UsageError("--html needs meshcat (its three.js viewer), which is not installed: pip install "
+                         "'ur3hanoi[replay]'")

@@ -1,8 +1,9 @@
 """The ``ur3hanoi`` parser and entry point: one line on stderr for every error, never a traceback.
 
 A library error (:class:`~ur3hanoi.errors.Ur3HanoiError`) prints ``ur3hanoi: error: <message>`` and exits with the
-code of :data:`ur3hanoi.cli.exit_codes.EXIT_CODES`; a bad option prints ``ur3hanoi <command>: error: argument
-...`` and exits 2; anything unexpected prints ``ur3hanoi <command>: internal error: ...`` and exits 70, and
+code of :data:`ur3hanoi.cli.exit_codes.EXIT_CODES`; a bad option prints ``ur3hanoi: error: argument ... (see
+ur3hanoi <command> --help)`` and exits 2; anything unexpected prints ``ur3hanoi: error: internal error in ur3hanoi
+<command>: ...`` and exits 70, and
 ``--debug`` shows its traceback instead.
 """
 
@@ -19,14 +20,17 @@ from ur3hanoi.cli import calibrate, check_table, exit_codes, plan, ros, ros2, so
 from ur3hanoi.errors import Ur3HanoiError, printable
 
 _COMMANDS = (tables, check_table, calibrate, plan, solve, ros, ros2)
+ERROR_PREFIX = "ur3hanoi: error:"
+"""What every error line on stderr starts with: bad input, bad options, a suction fault, an internal error."""
 _DEBUG_HELP = "on an internal error, show the Python traceback (for a bug report)"
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors: ``ur3hanoi plan: error: argument --rate: ... (see ur3hanoi plan --help)``."""
+    """argparse with one-line errors under the one prefix: ``ur3hanoi: error: argument --rate: ... (see ur3hanoi plan
+    --help)``."""
 
     def error(self, message: str) -> NoReturn:
-        self.exit(exit_codes.BAD_INPUT, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
+        self.exit(exit_codes.BAD_INPUT, f"{ERROR_PREFIX} {_one_line(message)} (see {self.prog} --help)\n")
 
 
 def _one_line(text: object) -> str:
@@ -83,7 +87,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except Ur3HanoiError as exc:
-        print(f"ur3hanoi: error: {_one_line(exc)}", file=sys.stderr)
+        print(f"{ERROR_PREFIX} {_one_line(exc)}", file=sys.stderr)
         return exit_codes.exit_code_for(exc)
     except KeyboardInterrupt:
         print(f"{prog}: interrupted", file=sys.stderr)
@@ -97,6 +101,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as exc:
         if args.debug:
             raise
-        print(f"{prog}: internal error: {type(exc).__name__}: {_one_line(exc) or '(no message)'} (a bug: rerun "
-              "with --debug for the traceback)", file=sys.stderr)
+        print(f"{ERROR_PREFIX} internal error in {prog}: {type(exc).__name__}: {_one_line(exc) or '(no message)'} "
+              "(a bug: rerun with --debug for the traceback)", file=sys.stderr)
         return exit_codes.INTERNAL

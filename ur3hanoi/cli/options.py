@@ -79,6 +79,27 @@ def option(spec: Number) -> Callable[[str], float | int]:
     return parse
 
 
+def station_number(what: str) -> Callable[[str], int]:
+    """An argparse ``type=`` for a tower, height or move number whose range is the station's or the instance's:
+    any integer here, checked once the station is loaded (:func:`check_number`), so the message gives the range
+    that applies (``--start 0`` on a 3-tower station: 1..3)."""
+
+    def parse(text: str) -> int:
+        value = _parse(text, integer=True)
+        if value is None:
+            raise argparse.ArgumentTypeError(f"{quote(text)} is invalid: expected {what}, an integer")
+        return int(value)
+
+    parse.__name__ = what
+    return parse
+
+
+def check_number(option_name: str, value: int | None, hi: int, what: str, why: str = "") -> None:
+    """``value`` (1-based) of ``option_name`` must be in 1..``hi``; ``why`` says where the bound comes from."""
+    if value is not None and not 1 <= value <= hi:
+        raise UsageError(f"{option_name} {value} is invalid: expected {what} 1..{hi}{f' ({why})' if why else ''}")
+
+
 def image_size(text: str) -> tuple[int, int]:
     """An argparse ``type=`` for ``WxH`` [px]: two integers in :data:`IMAGE_SIDE`, both even (H.264/VP9 video
     needs even sides; PNG frames follow the same rule so one size works for both)."""
@@ -108,10 +129,8 @@ def check_blocks(n_blocks: int, n_heights: int, given: bool) -> None:
 def check_faults(remove_block: int | None, drop_during_move: int | None, n_blocks: int) -> None:
     """The fault injections must name a height and a move of this instance (1-based)."""
     n_moves = 2**n_blocks - 1
-    if remove_block is not None and not 1 <= remove_block <= n_blocks:
-        raise UsageError(f"--remove-block {remove_block} is invalid: expected a height 1..{n_blocks}")
-    if drop_during_move is not None and not 1 <= drop_during_move <= n_moves:
-        raise UsageError(f"--drop-during-move {drop_during_move} is invalid: expected a move 1..{n_moves}")
+    check_number("--remove-block", remove_block, n_blocks, "a height", f"{n_blocks} blocks are spawned")
+    check_number("--drop-during-move", drop_during_move, n_moves, "a move", f"{n_blocks} blocks take {n_moves} moves")
 
 
 def check_plan_size(n_blocks: int, speed: float, dwell_s: float, rate_hz: float) -> None:

@@ -26,25 +26,25 @@ from ur3hanoi.cli.common import (
     calibration_ref,
     check_render_outputs,
     input_file,
+    require_replay,
     shown,
 )
 from ur3hanoi.cli.options import (
     BLOCKS,
     FPS,
-    HEIGHT,
-    MOVE,
     SEED,
     SIM_TIME,
     SPEED,
     TABLE_KEYS,
-    TOWER,
     UsageError,
     check_blocks,
     check_faults,
+    check_number,
     check_plan_size,
     check_window,
     image_size,
     option,
+    station_number,
 )
 from ur3hanoi.errors import SuctionFaultError, Ur3HanoiError
 
@@ -58,6 +58,10 @@ here: building the parser must not load MuJoCo)."""
 PROGRESS_STEP = 0.1
 """Fraction of the run between two plain progress lines (when stderr is not a terminal)."""
 
+SIM_SHARE = 0.05
+"""Share of the progress bar given to simulating when the frames render afterwards in worker processes (the
+simulation takes about 1.5 s of a 30 s video job); the rest counts the frames rendered."""
+
 
 def add(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("solve", help="run the lab in MuJoCo: plan, execute with suction feedback, verify",
@@ -66,8 +70,10 @@ def add(sub: argparse._SubParsersAction) -> None:
                                    "program halts like the lab's (suction off, arm home, exit 3) when a block is "
                                    "missing or dropped. Towers, heights and moves are numbered from 1. Without "
                                    "--start/--end it prompts on a terminal like the lab program.")
-    p.add_argument("--start", type=option(TOWER), metavar="S", help="start tower (1-based)")
-    p.add_argument("--end", type=option(TOWER), metavar="E", help="destination tower (1-based)")
+    p.add_argument("--start", type=station_number("a tower number"), metavar="S",
+                   help="start tower (1-based, 1..the station's towers)")
+    p.add_argument("--end", type=station_number("a tower number"), metavar="E",
+                   help="destination tower (1-based, 1..the station's towers)")
     p.add_argument("--blocks", type=option(BLOCKS), default=None, metavar="N",
                    help=f"{BLOCKS.expected()} (default: the grid's heights, 3 on the lab)")
     p.add_argument("--calibration", default=None, metavar="CAL",
@@ -78,9 +84,9 @@ def add(sub: argparse._SubParsersAction) -> None:
                         "joint moves between its entries like the lab program; a missed block halts (exit 3) "
                         "naming the table entry")
     p.add_argument("--key", choices=TABLE_KEYS, help="the table key to follow (with --table)")
-    p.add_argument("--remove-block", type=option(HEIGHT), metavar="H",
+    p.add_argument("--remove-block", type=station_number("a height"), metavar="H",
                    help="fault injection: spawn without the block at height H (1-based), like lab2_spawn.py")
-    p.add_argument("--drop-during-move", type=option(MOVE), metavar="M",
+    p.add_argument("--drop-during-move", type=station_number("a move number"), metavar="M",
                    help="fault injection: the suction loses its block in the middle of move M's carry (1-based)")
     p.add_argument("--speed", type=option(SPEED), default=1.0, metavar="F",
                    help=f"fraction of the joint speed/acceleration/jerk limits, in [{SPEED.lo:g}, {SPEED.hi:g}] "
@@ -104,6 +110,9 @@ def add(sub: argparse._SubParsersAction) -> None:
                    help="report progress on stderr also when it is not a terminal (plain lines every 10 %%; on by "
                         "default when rendering)")
     p.add_argument("--view", action="store_true", help="open MuJoCo's interactive viewer (needs a display)")
+    p.add_argument("--html", metavar="FILE",
+                   help="write a replay page: one offline HTML file (3-D arm and blocks, timeline, move and suction "
+                        "state, the halt on a fault); FILE#t=12.5 opens at 12.5 s")
     p.add_argument("--json", action="store_true", help="print one JSON object with the outcome on stdout")
     add_suction_profile_option(p)
     p.set_defaults(func=run)
@@ -123,6 +132,16 @@ def prompt_tower(what: str, n_towers: int, exclude: int | None = None) -> int:
         if text.isdigit() and len(text) < 4 and 1 <= int(text) <= n_towers and int(text) - 1 != exclude:
             return int(text) - 1
         print(f"Please just enter the character {label}\n")
+
+
+def render_workers() -> int:
+    """Processes rendering video frames: one per core the process may use (software GL renders one frame per
+    core at a time), at most 8."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    return max(1, min(8, cores))
 
 
 def _progress(fraction: float, label: str) -> None:
@@ -151,6 +170,20 @@ class _ProgressLines:
         print(f"ur3hanoi solve: {100 * fraction:3.0f} % ({label}{extra})", file=sys.stderr, flush=True)
 
 
+def _phases(progress: ProgressFn | None) -> tuple[ProgressFn | None, ProgressFn | None]:
+    """One progress bar over two phases: the simulation (:data:`SIM_SHARE`), then the frames rendered."""
+    if progress is None:
+        return None, None
+
+    def simulating(fraction: float, label: str) -> None:
+        progress(SIM_SHARE * fraction, "simulated" if fraction >= 1.0 else label)
+
+    def rendering(fraction: float, label: str) -> None:
+        progress(SIM_SHARE + (1.0 - SIM_SHARE) * fraction, label)
+
+    return simulating, rendering
+
+
 def _progress_sink(args: argparse.Namespace, recorder: object | None) -> ProgressFn | None:
     """A bar on a terminal; plain lines when rendering or with --progress; nothing otherwise (and never with
     --view, whose window shows the run)."""
@@ -175,11 +208,25 @@ def _check_render_options(args: argparse.Namespace) -> None:
 
 def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
     """Refuse a video or frames path that cannot be written, before simulating anything."""
+    from ur3hanoi.io.atomic import check_output
+
+    if args.html:
+        require_replay()
+        check_output(args.html, inputs=inputs)
+    if args.video:
+        try:
+            import imageio_ffmpeg  # noqa: F401  (the "video" extra)
+        except ImportError:
+            raise UsageError("--video needs the video extra (imageio-ffmpeg, which ships ffmpeg): pip install "
+                             "'ur3hanoi[video]'; or write PNG frames with --frames DIR") from None
     check_render_outputs(args.video, args.frames, inputs)
 
 
-def _towers(args: argparse.Namespace, n_towers: int) -> tuple[int, int]:
+def _towers(args: argparse.Namespace, n_towers: int, station_name: str = "") -> tuple[int, int]:
     """Start and end tower, 0-based: from the options, or prompted for on a terminal."""
+    why = f"{station_name} has {n_towers} towers" if station_name else ""
+    check_number("--start", args.start, n_towers, "a tower", why)
+    check_number("--end", args.end, n_towers, "a tower", why)
     if args.start is not None and args.end is not None:
         return args.start - 1, args.end - 1
     if not sys.stdin.isatty():
@@ -232,7 +279,7 @@ def run(args: argparse.Namespace) -> int:
     n_towers = station.n_towers
     n_blocks = station.n_heights if args.blocks is None else args.blocks
     check_blocks(n_blocks, station.n_heights, given=args.blocks is not None)
-    start, end = _towers(args, n_towers)
+    start, end = _towers(args, n_towers, station.name)
     validate_instance(n_blocks, start, end, n_towers, station.n_heights)
     if recorded is not None:
         table = recorded.for_solve(start, end, n_blocks)
@@ -274,25 +321,40 @@ def run(args: argparse.Namespace) -> int:
     scene = build_task_scene(station, start, n_blocks, faults.remove_block, config.scene)
     sink: object | None = None
     fault: Ur3HanoiError | None = None
+    sim_progress: ProgressFn | None = None
+    render_progress: ProgressFn | None = None
     try:
         if args.view:
             sink = ViewerSink(scene.model, scene.data)
         elif args.video or args.frames:
+            workers = render_workers()
+            if workers > 1:  # frames render after the run, in worker processes: one bar over both phases
+                sim_progress, render_progress = _phases(_progress_sink(args, None))
             default = CameraConfig()
             width, height = args.size if args.size is not None else (default.width, default.height)
             camera = CameraConfig(width=width, height=height, fps=args.fps if args.fps is not None else default.fps)
             sink = OffscreenRecorder(station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
                                      video=Path(args.video) if args.video else None, camera=camera,
-                                     t_from=args.t_from or 0.0, t_to=args.t_to)
-        progress = _progress_sink(args, sink if args.video or args.frames else None)
+                                     t_from=args.t_from or 0.0, t_to=args.t_to, workers=workers,
+                                     progress=render_progress)
+        if sim_progress is None:
+            sim_progress = _progress_sink(args, sink if args.video or args.frames else None)
+        frames = sink
+        if args.html:
+            from ur3hanoi.replay import REPLAY_FPS, PoseRecorder, SinkTee
+
+            replay = PoseRecorder(scene.model, REPLAY_FPS)
+            frames = replay if sink is None else SinkTee([sink, replay])  # type: ignore[list-item]
         try:
-            result = run_plan(plan, faults, config, frames=sink, progress=progress,  # type: ignore[arg-type]
+            result = run_plan(plan, faults, config, frames=frames, progress=sim_progress,  # type: ignore[arg-type]
                               scene=scene, realtime=args.view)
         except SuctionFaultError as exc:
             # A halted run still has a result to report (the final block positions, the halt).
             if not isinstance(exc.result, SimResult):
                 raise
             result, fault = exc.result, exc
+        if isinstance(sink, OffscreenRecorder):
+            sink.render_pending()  # the frames, in parallel processes (progress per frame)
     except BaseException:
         if isinstance(sink, OffscreenRecorder):
             sink.discard()  # an interrupted or failed run leaves an existing video or folder as it was
@@ -301,6 +363,14 @@ def run(args: argparse.Namespace) -> int:
         if sink is not None:
             sink.close()  # type: ignore[attr-defined]
 
+    html_size = None
+    if args.html:
+        from ur3hanoi.replay import write_run_replay
+
+        following = f", following {args.table}:{args.key}" if args.table is not None else ""
+        title = (f"{station.name}: {n_blocks} blocks, tower {start + 1} -> {end + 1}{following}: {result.status} "
+                 f"({result.moves_completed}/{result.moves_total} moves)")
+        html_size = write_run_replay(args.html, plan, scene, replay, result, title, tuple(inputs))
     if args.json:
         out = result.as_dict()
         out["suction"] = station.suction.as_dict()
@@ -323,6 +393,8 @@ def run(args: argparse.Namespace) -> int:
               f"{'on' if result.suction_on_at_end else 'off'}, {'at' if result.at_home_at_end else 'not at'} home")
         if args.video or args.frames:
             print(f"  wrote {sink.count} frames to {shown(args.video or args.frames)}")  # type: ignore[union-attr]
+        if html_size is not None:
+            print(f"  wrote the replay page {shown(args.html)} ({html_size / 1e6:.1f} MB)")
     if fault is not None:
         print(f"ur3hanoi: error: {' '.join(str(fault).split())}", file=sys.stderr)
         return exit_codes.exit_code_for(fault)

@@ -10,6 +10,7 @@ makes a controller move by its tracking error).
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -35,6 +36,8 @@ class ArmConfig:
         poll_s: period [s] of the waiting loops.
         move_timeout_s: give up on a move after this long [s].
         connect_timeout_s: wait this long [s] for the driver's topics.
+        position_timeout_s: a move fails when no ``ur3/position`` arrived for this long [s] (the driver publishes
+            it every control cycle: silence means it stopped, not that the arm is slow).
     """
 
     v: float = 4.0
@@ -44,6 +47,7 @@ class ArmConfig:
     poll_s: float = 0.004
     move_timeout_s: float = 60.0
     connect_timeout_s: float = 15.0
+    position_timeout_s: float = 2.0
 
 
 class RosArm:
@@ -63,6 +67,7 @@ class RosArm:
         self.master_uri = master_uri or master_uri_from_env()
         self.log = log if log is not None else (lambda s: print(s, file=sys.stderr))
         self._q: FloatArray | None = None
+        self._t_position = -math.inf  # time.monotonic() of the last ur3/position message
         self._digin: int | None = None
         self._ain0 = float("nan")
         self._destination: FloatArray | None = None
@@ -75,6 +80,7 @@ class RosArm:
     # --------------------------------------------------------------------------------------------- callbacks
     def _on_position(self, msg: Any) -> None:
         self._q = np.array(msg.position, dtype=float)
+        self._t_position = time.monotonic()
 
     def _on_gripper(self, msg: Any) -> None:
         self._ain0 = float(msg.AIN0)
@@ -166,6 +172,10 @@ class RosArm:
             if self._q is not None and float(np.max(np.abs(self._q - goal))) < cfg.tolerance_rad:
                 return
             now = time.monotonic()
+            silent = now - max(self._t_position, t0)
+            if silent > cfg.position_timeout_s:
+                raise RosError(f"position updates stopped: no message on /ur3/position for {silent:.1f} s (the "
+                               "driver publishes it every cycle); is the driver still running?")
             if now - t0 > cfg.move_timeout_s:
                 err = float(np.max(np.abs(self.q - goal)))
                 raise RosError(f"the arm did not reach {np.round(goal, 4).tolist()} within {cfg.move_timeout_s:g} s "

@@ -390,7 +390,8 @@ class RosStation:
         frame_dt = 1.0 / sink.fps if sink is not None else math.inf
         next_frame = 0.0
         st = self.station
-        self.out(f"{READY_LINE} on {self.master_uri}: {st.name}, {w.n_blocks} blocks on tower {opts.start + 1}, "
+        spawned = w.n_blocks - len(w.removed)  # --remove-block leaves one out
+        self.out(f"{READY_LINE} on {self.master_uri}: {st.name}, {spawned} blocks on tower {opts.start + 1}, "
                  f"{1.0 / period:g} Hz, suction profile {w.cup.profile.name} (pid {os.getpid()})")
         # Everything built so far lives as long as the node: keep the cyclic collector from scanning it in the loop.
         gc.collect()

@@ -20,6 +20,7 @@ import contextlib
 import math
 import os
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -44,10 +45,14 @@ class VideoFormat:
     params: tuple[str, ...] = ()
 
 
+# H.264 at x264's "veryfast" preset: 4.6 instead of 6.9 ms of CPU a 640x480 frame, a smaller file at the same
+# quality (bench/bench_render.py).
+_H264 = VideoFormat("libx264", params=("-preset", "veryfast"))
+
 VIDEO_FORMATS: dict[str, VideoFormat] = {
-    ".mp4": VideoFormat("libx264"),
-    ".mkv": VideoFormat("libx264"),
-    ".mov": VideoFormat("libx264"),
+    ".mp4": _H264,
+    ".mkv": _H264,
+    ".mov": _H264,
     # VP9 needs an explicit constant quality (crf with a zero bitrate), or ffmpeg warns and picks one.
     ".webm": VideoFormat("libvpx-vp9", quality=None, params=("-crf", "32", "-b:v", "0")),
     # GIF: ffmpeg's own palette (pal8), no chroma subsampling, so any size works.
@@ -88,6 +93,11 @@ class CameraConfig:
         width, height: image size [px]; videos other than GIF need even numbers (H.264/VP9 chroma subsampling).
         fps: frames per second of sim time [Hz] (at most the control rate: the executor offers a frame per cycle).
         distance: [m] from the look-at point; azimuth, elevation: [deg], MuJoCo's free-camera convention.
+        shadow_size: side of the shadow map [px] (0: no shadows). MuJoCo's default 4096 costs most of a frame in
+            software GL; at 1024 the arm's shadow on the table looks the same at 640x480 (see bench/bench_render.py).
+        reflections: mirror the scene in reflective materials (the floor); off: a software-GL pass saved.
+        multisamples: MSAA samples of the offscreen buffer (MuJoCo's default 4; 0 off: a few jagged edges, the
+            largest saving after shadows).
     """
 
     width: int = 640
@@ -96,30 +106,87 @@ class CameraConfig:
     distance: float = 1.1
     azimuth: float = 200.0
     elevation: float = -30.0
+    shadow_size: int = 1024
+    reflections: bool = False
+    multisamples: int = 0
+
+
+def _lookat(station: Station) -> tuple[float, float, float]:
+    """The camera's look-at point [m, world]: between the robot base and the towers, 0.1 m up."""
+    pts = slot_centers(station).reshape(-1, 3)
+    p = 0.5 * (np.mean(pts, axis=0) + np.asarray(station.base_xyz)) + np.array([0.0, 0.0, 0.1])
+    return float(p[0]), float(p[1]), float(p[2])
+
+
+def _camera(lookat: tuple[float, float, float], cam: CameraConfig) -> mujoco.MjvCamera:
+    c = mujoco.MjvCamera()
+    c.type = mujoco.mjtCamera.mjCAMERA_FREE
+    c.lookat[:] = lookat
+    c.distance, c.azimuth, c.elevation = cam.distance, cam.azimuth, cam.elevation
+    return c
 
 
 def _free_camera(station: Station, cam: CameraConfig) -> mujoco.MjvCamera:
-    c = mujoco.MjvCamera()
-    c.type = mujoco.mjtCamera.mjCAMERA_FREE
-    pts = slot_centers(station).reshape(-1, 3)
-    c.lookat[:] = 0.5 * (np.mean(pts, axis=0) + np.asarray(station.base_xyz)) + np.array([0.0, 0.0, 0.1])
-    c.distance, c.azimuth, c.elevation = cam.distance, cam.azimuth, cam.elevation
-    return c
+    return _camera(_lookat(station), cam)
+
+
+def _set_quality(model: mujoco.MjModel, cam: CameraConfig) -> None:
+    """Size the offscreen framebuffer to the image and set the shadow map and multisampling (read when a renderer
+    is created)."""
+    vis = model.vis
+    vis.global_.offwidth = max(vis.global_.offwidth, cam.width)
+    vis.global_.offheight = max(vis.global_.offheight, cam.height)
+    vis.quality.shadowsize = max(0, int(cam.shadow_size))
+    vis.quality.offsamples = max(0, int(cam.multisamples))
+
+
+def _draw(renderer: mujoco.Renderer, data: mujoco.MjData, camera: mujoco.MjvCamera, cam: CameraConfig) -> Any:
+    """One frame: the scene of ``data`` seen by ``camera``, with the config's shadow and reflection flags."""
+    renderer.update_scene(data, camera)
+    flags = renderer.scene.flags
+    flags[mujoco.mjtRndFlag.mjRND_SHADOW] = cam.shadow_size > 0
+    flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = cam.reflections
+    return renderer.render()
+
+
+# A rendering worker process's state (set by _init_worker; one renderer per process).
+_WORKER: dict[str, Any] = {}
+
+
+def _init_worker(model: mujoco.MjModel, lookat: tuple[float, float, float], cam: CameraConfig) -> None:
+    # One llvmpipe thread per process: the processes are the parallelism (read when the GL driver loads).
+    os.environ.setdefault("LP_NUM_THREADS", "1")
+    _WORKER["model"], _WORKER["data"] = model, mujoco.MjData(model)
+    _WORKER["renderer"] = mujoco.Renderer(model, cam.height, cam.width)
+    _WORKER["camera"], _WORKER["cam"] = _camera(lookat, cam), cam
+
+
+def _render_state(state: tuple[float, Any]) -> Any:
+    """Render the joint state ``(t [s], qpos)`` in a worker process."""
+    m, d = _WORKER["model"], _WORKER["data"]
+    d.time, d.qpos[:] = state[0], state[1]
+    mujoco.mj_forward(m, d)
+    return np.ascontiguousarray(_draw(_WORKER["renderer"], d, _WORKER["camera"], _WORKER["cam"]))
 
 
 class OffscreenRecorder:
     """Renders frames offscreen (``mujoco.Renderer``) into PNG files (``frames_dir``) or a video file (``video``).
 
     Only frames whose sim time lies in ``[t_from, t_to]`` [s] are rendered (``t_to`` None: to the end); ``count``
-    is the number written. Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo is imported.
-    A video needs ``imageio-ffmpeg`` (its wheel ships ffmpeg) and an extension of :data:`VIDEO_FORMATS`; PNG needs
-    only Pillow. Use as a context manager (it closes the renderer and finishes the file, or :meth:`discard` s it
-    when the block raises). The output is checked here (:mod:`ur3hanoi.io.atomic`) and written only on close.
+    is the number written. With ``workers`` > 1 the run only records each frame's joint state, and
+    :meth:`render_pending` (called by the context manager on success) renders them in that many processes
+    (``spawn``, one software-GL thread each), in order, reporting ``progress(fraction, label)`` per frame, while
+    ffmpeg encodes in its own process. Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo
+    is imported. A video needs ``imageio-ffmpeg`` (its wheel ships ffmpeg) and an extension of
+    :data:`VIDEO_FORMATS`; PNG needs only Pillow. Use as a context manager (it closes the renderer and finishes the
+    file, or :meth:`discard` s it when the block raises). The output is checked here (:mod:`ur3hanoi.io.atomic`)
+    and written only on close.
     """
 
     def __init__(self, station: Station, model: mujoco.MjModel, frames_dir: Path | None = None,
                  video: Path | None = None, camera: CameraConfig | None = None, t_from: float = 0.0,
-                 t_to: float | None = None) -> None:
+                 t_to: float | None = None, workers: int = 1,
+                 progress: Callable[[float, str], None] | None = None) -> None:
         if (frames_dir is None) == (video is None):
             raise SimulationError("give exactly one of a frames directory or a video file")
         self.cam_cfg = camera if camera is not None else CameraConfig()
@@ -147,8 +214,9 @@ class OffscreenRecorder:
 
                 imageio_ffmpeg.get_ffmpeg_exe()
             except ImportError:
-                raise SimulationError(f"cannot write the video {printable(video)}: it needs the package "
-                                      "imageio-ffmpeg (not installed); write PNG frames (frames_dir) instead") from None
+                raise SimulationError(f"cannot write the video {printable(video)}: it needs imageio-ffmpeg (not "
+                                      "installed): pip install 'ur3hanoi[video]'; or write PNG frames (frames_dir)"
+                                      ) from None
             except RuntimeError as exc:  # no ffmpeg binary found
                 raise SimulationError(f"cannot write the video {printable(video)}: {exc}") from None
             self._video_format = fmt
@@ -157,8 +225,10 @@ class OffscreenRecorder:
             assert frames_dir is not None
             self._frames_out = check_output_dir(frames_dir)
         # MuJoCo's offscreen framebuffer is the model's (640x480 unless the XML says otherwise): make it fit.
-        vis = model.vis.global_
-        vis.offwidth, vis.offheight = max(vis.offwidth, cam.width), max(vis.offheight, cam.height)
+        _set_quality(model, cam)
+        self.model, self.lookat = model, _lookat(station)
+        self.workers, self.progress = max(1, int(workers)), progress
+        self._states: list[tuple[float, Any]] = []  # (t, qpos) of the frames to render in parallel at close()
         try:
             self.renderer = mujoco.Renderer(model, cam.height, cam.width)
         except ValueError:  # a size the framebuffer does not hold: a bug here, not a missing OpenGL
@@ -167,6 +237,14 @@ class OffscreenRecorder:
             raise SimulationError(f"offscreen rendering is unavailable ({exc}); on a headless machine set "
                                   "MUJOCO_GL=egl (libegl1) or MUJOCO_GL=osmesa (libosmesa6)") from None
         self.camera = _free_camera(station, cam)
+        self._pool: Any = None
+        if self.workers > 1:
+            # Start the rendering processes now: they import MuJoCo and make their GL contexts while the run is
+            # simulated.
+            import multiprocessing
+
+            ctx = multiprocessing.get_context("spawn")  # a fresh GL context per process, nothing inherited
+            self._pool = ctx.Pool(self.workers, initializer=_init_worker, initargs=(model, self.lookat, cam))
 
     def _open_writer(self) -> Any:
         """Start ffmpeg on the first frame: a run with no frame in the window leaves no (invalid) video behind."""
@@ -188,8 +266,13 @@ class OffscreenRecorder:
         t = float(data.time)
         if not self.t_from - 1e-9 <= t <= self.t_to + 1e-9:
             return
-        self.renderer.update_scene(data, self.camera)
-        pixels = self.renderer.render()
+        if self.workers > 1:  # rendered in worker processes by render_pending()
+            self._states.append((t, data.qpos.copy()))
+            return
+        self._emit(_draw(self.renderer, data, self.camera, self.cam_cfg))
+
+    def _emit(self, pixels: Any) -> None:
+        """Write one frame; a failure discards the output (an existing file or folder stays as it was)."""
         try:
             self._write(pixels)
         except BaseException as exc:
@@ -201,6 +284,7 @@ class OffscreenRecorder:
         self.count += 1
 
     def _write(self, pixels: Any) -> None:
+        """Append one rendered frame to the video or the frames directory."""
         if self.video is not None:
             if self._writer is None:
                 self._writer = self._open_writer()
@@ -238,7 +322,27 @@ class OffscreenRecorder:
         if pending is not None:
             pending.discard()
 
+    def render_pending(self) -> None:
+        """Render the frames recorded for the worker processes, in order, streaming them into the video (ffmpeg
+        encodes in its own process meanwhile) or the frames directory; reports progress per frame."""
+        states, self._states = self._states, []
+        if not states or self._pool is None:
+            return
+        n = len(states)
+        every = max(1, n // 100)
+        for i, pixels in enumerate(self._pool.imap(_render_state, states, chunksize=2), start=1):
+            self._emit(pixels)
+            if self.progress is not None and (i % every == 0 or i == n):
+                self.progress(i / n, f"frame {i}/{n}")
+
     def close(self) -> None:
+        """Release the renderer and finish the file; frames recorded for the workers and not yet rendered
+        (:meth:`render_pending`) are dropped (an interrupted run)."""
+        self._states = []
+        if self._pool is not None:
+            pool, self._pool = self._pool, None
+            pool.terminate()
+            pool.join()
         try:
             self.renderer.close()
         finally:
@@ -248,9 +352,16 @@ class OffscreenRecorder:
         return self
 
     def __exit__(self, exc_type: object, *exc: object) -> None:
-        if exc_type is not None:
+        try:
+            if exc_type is not None:
+                self.discard()
+            else:
+                self.render_pending()
+        except BaseException:
             self.discard()
-        self.close()
+            raise
+        finally:
+            self.close()
 
 
 def display_available() -> str | None:

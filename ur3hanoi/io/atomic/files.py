@@ -137,6 +137,10 @@ class Output:
     def exists(self) -> bool:
         return self.path.exists()
 
+    def write_bytes(self, data: bytes) -> None:
+        """Replace the file with ``data`` atomically (pictures, pages)."""
+        self.write(data)
+
     def write(self, text: str | bytes) -> None:
         """Replace the file with ``text`` (UTF-8) atomically; see the module docstring."""
         data = text.encode("utf-8") if isinstance(text, str) else bytes(text)

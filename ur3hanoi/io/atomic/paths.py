@@ -107,7 +107,7 @@ def check_parent(parent: Path, shown: str) -> None:
     try:
         pst = os.stat(parent)
     except FileNotFoundError:
-        raise refuse(shown, f"the directory {printable(parent)} does not exist") from None
+        raise refuse(shown, f"the directory {printable(parent)} does not exist (create it first: mkdir -p)") from None
     except OSError as exc:
         raise refuse(shown, f"the directory {printable(parent)} is unusable ({exc.strerror})") from None
     if not stat.S_ISDIR(pst.st_mode):
