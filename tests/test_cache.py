@@ -191,7 +191,7 @@ _RACER = textwrap.dedent("""
     from pathlib import Path
     import numpy as np
     import ur3hanoi.cache as cache
-    from ur3hanoi.plan.collision import CollisionScene
+    from ur3hanoi.plan import CollisionScene
     from ur3hanoi.station import load_station
     real_load, real_store, first = cache.load, cache.store, []
     def load(kind, key):

@@ -14,17 +14,12 @@ import ast
 from collections import deque
 from pathlib import Path
 
-import pytest
-
 import ur3hanoi
 
 PACKAGE_DIR = Path(ur3hanoi.__file__).resolve().parent
 
-KNOWN_CYCLES: frozenset[frozenset[str]] = frozenset({
-    # plan.types <-> plan.export (via plan.vertical): the plan package is regrouped on another branch of issue 18;
-    # remove this entry when that branch is merged (test_known_cycles_still_exist then fails as a reminder).
-    frozenset({"ur3hanoi.plan.export", "ur3hanoi.plan.types", "ur3hanoi.plan.vertical"}),
-})
+KNOWN_CYCLES: frozenset[frozenset[str]] = frozenset()
+"""Cycles tolerated for now (none): an entry here must name a tracked issue."""
 
 
 def module_files(package_dir: Path = PACKAGE_DIR) -> dict[str, Path]:
@@ -130,13 +125,6 @@ def test_no_import_cycles() -> None:
     graph = import_graph(module_files())
     unexpected = [g for g in cyclic_groups(graph) if g not in KNOWN_CYCLES]
     assert not unexpected, "import cycles: " + "; ".join(" -> ".join(a_cycle(g, graph)) for g in unexpected)
-
-
-@pytest.mark.xfail(strict=True, reason="known cycle plan.types <-> plan.export, fixed on the plan branch (issue 18)")
-def test_known_cycles_still_exist() -> None:
-    """Expected to fail while KNOWN_CYCLES is not empty; once the cycle is gone this passes, and strict xfail
-    turns that into a failure: remove the entry from KNOWN_CYCLES (and this marker)."""
-    assert not cyclic_groups(import_graph(module_files()))
 
 
 def test_the_graph_sees_every_kind_of_import(tmp_path: Path) -> None:

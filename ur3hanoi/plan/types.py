@@ -18,6 +18,7 @@ from ruckig import Trajectory as RuckigTrajectory
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
 from ur3hanoi.hanoi import Move
+from ur3hanoi.plan.motion.limits import KinematicLimits
 from ur3hanoi.robot import N_JOINTS
 from ur3hanoi.station import Station
 
@@ -90,15 +91,6 @@ class Trajectory:
     @property
     def duration_s(self) -> float:
         return float(self.t[-1] - self.t[0])
-
-
-@dataclass(frozen=True)
-class KinematicLimits:
-    """Per-joint limits used for planning [rad/s, rad/s^2, rad/s^3], already scaled by ``PlanConfig.speed``."""
-
-    v_max: FloatArray
-    a_max: FloatArray
-    j_max: FloatArray
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
 from ur3hanoi.grid import ABOVE, ON, T_base_tcp
 from ur3hanoi.ik import analytic_ik, branch_of, nearest_equivalent
-from ur3hanoi.plan.types import KinematicLimits
+from ur3hanoi.plan.motion.limits import KinematicLimits
 from ur3hanoi.robot import N_JOINTS, Ur3Model
 from ur3hanoi.station import Station
 
