@@ -150,9 +150,12 @@ def audit_figure(report: AuditReport, title: str = "") -> Figure:
         ax.set_ylabel(ylabel)
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, lw=0.3, alpha=0.5)
+    plain = "fitted grid" if report.fitted else "calibration"
+    on_ref, above_ref = ("fit of the other contacts", "nearest accepted") if report.rule is not None else (plain, plain)
     handles = [Line2D([], [], ls="-", marker="s", lw=0.8, color=GRID_COLOUR, mfc="none", mec=GRID_COLOUR,
-                      label="reference: on"),
-               Line2D([], [], ls="none", marker="^", mfc="none", mec=GRID_COLOUR, label="reference: above")]
+                      label=f"reference: on ({on_ref})"),
+               Line2D([], [], ls="none", marker="^", mfc="none", mec=GRID_COLOUR,
+                      label=f"reference: above ({above_ref})")]
     shown = [("ok", Line2D([], [], ls="none", marker="o", color=OK_COLOUR, label="recorded: ok")),
              ("unchecked", Line2D([], [], ls="none", marker="o", mfc="none", mec=OK_COLOUR,
                                   label="recorded: unchecked")),
