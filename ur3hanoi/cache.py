@@ -106,15 +106,15 @@ def cached(kind: str, inputs: Iterable[bytes], build: Callable[[], T], encode: C
     """The value of entry (``kind``, key of ``inputs``) through ``decode``, else ``build()``, kept through
     ``encode`` for the next process.
 
-    ``decode`` returns None (or raises ValueError, TypeError, KeyError or IndexError) for a payload it does not
-    accept: such an entry is rebuilt and overwritten. ``encode`` returns None for a value not to be kept.
+    ``decode`` returns None (or raises) for a payload it does not accept: such an entry is rebuilt and
+    overwritten. ``encode`` returns None for a value not to be kept.
     """
     key = content_key(kind, inputs)
     payload = load(kind, key)
     if payload is not None:
         try:
             value = decode(payload)
-        except (ValueError, TypeError, KeyError, IndexError):
+        except Exception:  # whatever a payload that is not this kind's makes a decoder raise: rebuild it
             value = None
         if value is not None:
             return value

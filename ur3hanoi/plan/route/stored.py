@@ -9,34 +9,28 @@ geometry, the robot model and the planning settings alone. :func:`connect` keeps
   bit). The Ruckig trajectories are recalculated from the states (one calculation per segment, deterministic: the
   same trajectories as the search produced, since every segment of a connection is one Ruckig calculation between
   two consecutive states). A connection with an exact path-following leg (a 1-DoF trajectory) is not kept.
-- **Key**: the station geometry (the :class:`~ur3hanoi.station.Station` value without its name and file, every
-  float by ``repr``), the robot model (its URDF text with the tool frame), the planning limits, corridor, via grid,
-  pass-through and blend settings, the connection (slots and over heights), the Ruckig and NumPy versions, and the
-  source of the planner (the ``ur3hanoi.plan`` package and the top-level modules): a changed input or a changed
-  planner is a new entry, never a stale plan.
+- **Key**: :func:`~ur3hanoi.plan.cache_key.station_inputs` (station geometry, robot model, Ruckig and NumPy
+  versions, the planner's source), the planning limits, corridor, via grid, pass-through and blend settings, and
+  the connection (slots and over heights): a changed input or a changed planner is a new entry, never a stale plan.
 - An entry that does not decode, or whose states Ruckig no longer connects, is rebuilt (see :func:`ur3hanoi.cache.cached`).
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
 from collections.abc import Sequence
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
 from ur3hanoi.cache import cached
+from ur3hanoi.plan.cache_key import station_inputs
 from ur3hanoi.plan.motion.legs import Leg, State
 from ur3hanoi.plan.route.connections import Connection, ConnectionKey, Slot, StationPlanner
 from ur3hanoi.plan.waypoints import geometry_key
-from ur3hanoi.robot import load_ur3
 
 CONNECTION = "plan-connection"
 """Kind of the cache entries of :func:`connect`."""
-
-_PACKAGE = Path(__file__).resolve().parents[2]  # ur3hanoi/
 
 
 def connect(planner: StationPlanner, slot0: Slot | None, slot1: Slot | None, over0: float | None = None,
@@ -52,27 +46,12 @@ def connect(planner: StationPlanner, slot0: Slot | None, slot1: Slot | None, ove
     return found
 
 
-@lru_cache(maxsize=1)
-def _source_digest() -> bytes:
-    """sha256 of the planner's source: the ``ur3hanoi.plan`` package and the top-level modules."""
-    h = hashlib.sha256()
-    for path in [*sorted((_PACKAGE / "plan").rglob("*.py")), *sorted(_PACKAGE.glob("*.py"))]:
-        h.update(path.relative_to(_PACKAGE).as_posix().encode() + b"\0")
-        h.update(hashlib.sha256(path.read_bytes()).digest())
-    return h.digest()
-
-
 @lru_cache(maxsize=8)
 def _planner_inputs(planner: StationPlanner) -> tuple[bytes, ...]:
-    import ruckig
-
-    st = planner.station
     lim = planner.limits
     settings = (lim.v_max.tolist(), lim.a_max.tolist(), lim.j_max.tolist(), planner.tol_m, planner.via_speeds,
                 planner.via_accels, planner.blend)
-    return (f"ruckig {ruckig.__version__}, numpy {np.__version__}".encode(), _source_digest(),
-            repr(geometry_key(st)).encode(), load_ur3(st.tool, st.limits, st.robot).urdf.encode(),
-            repr(settings).encode())
+    return (*station_inputs(geometry_key(planner.station)), repr(settings).encode())
 
 
 def _encode_states(states: Sequence[State]) -> list[list[list[float]]]:
