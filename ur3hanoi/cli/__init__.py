@@ -12,7 +12,7 @@ import os
 # unless the user chose otherwise (set before anything imports NumPy).
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-from ur3hanoi.cli.main import build_parser, help_markdown, main  # noqa: E402
-from ur3hanoi.cli.solve import prompt_tower  # noqa: E402
+from ur3hanoi.cli.main import build_parser, help_markdown, main
+from ur3hanoi.cli.solve import prompt_tower
 
 __all__ = ["build_parser", "help_markdown", "main", "prompt_tower"]

@@ -54,29 +54,35 @@ def _cached_waypoints(station: Station, node_step_m: float) -> Waypoints:
                   lambda payload: _decode(payload, station))
 
 
-_PATH_ARRAYS = ("s", "q", "dq", "ddq", "dddq")
-
-
 def _encode(wp: Waypoints) -> bytes:
-    arrays = {"q_home": wp.q_home, "table": wp.table}
-    for t, paths in enumerate(wp.vertical):
-        for h, path in enumerate(paths):
-            arrays.update({f"{name}_{t}_{h}": getattr(path, name) for name in _PATH_ARRAYS})
+    """NumPy's ``.npz`` of q_home, the table, then (s, q, dq, ddq, dddq) of every path, tower by tower."""
+    arrays = [wp.q_home, wp.table]
+    for paths in wp.vertical:
+        for p in paths:
+            arrays += [p.s, p.q, p.dq, p.ddq, p.dddq]
     buf = io.BytesIO()
-    np.savez(buf, **arrays)
+    np.savez(buf, *arrays)
     return buf.getvalue()
 
 
 def _decode(payload: bytes, station: Station) -> Waypoints | None:
-    with np.load(io.BytesIO(payload), allow_pickle=False) as npz:
-        arrays = {name: np.asarray(npz[name], dtype=np.float64) for name in npz.files}
     n_t, n_h = station.n_towers, station.n_heights
-    table = arrays["table"]
-    if table.shape != (n_t, n_h, 2, 6) or arrays["q_home"].shape != (6,):
+    with np.load(io.BytesIO(payload), allow_pickle=False) as npz:
+        if len(npz.files) != 2 + 5 * n_t * n_h:
+            return None
+        arrays = [np.asarray(npz[f"arr_{i}"], dtype=np.float64) for i in range(len(npz.files))]
+    q_home, table = arrays[0], arrays[1]
+    if table.shape != (n_t, n_h, 2, 6) or q_home.shape != (6,):
         return None
-    vertical = tuple(tuple(VerticalPath(*(arrays[f"{name}_{t}_{h}"] for name in _PATH_ARRAYS),
-                                        length_m=station.approach) for h in range(n_h)) for t in range(n_t))
-    return Waypoints(q_home=arrays["q_home"], table=table, vertical=vertical)
+
+    def path(k: int) -> VerticalPath:
+        s, q, dq, ddq, dddq = arrays[2 + 5 * k: 7 + 5 * k]
+        if not (s.ndim == 1 and q.shape == dq.shape == ddq.shape == dddq.shape == (len(s), 6)):
+            raise ValueError("malformed vertical path")
+        return VerticalPath(s=s, q=q, dq=dq, ddq=ddq, dddq=dddq, length_m=station.approach)
+
+    vertical = tuple(tuple(path(t * n_h + h) for h in range(n_h)) for t in range(n_t))
+    return Waypoints(q_home=q_home, table=table, vertical=vertical)
 
 
 def _build_waypoints(station: Station, node_step_m: float) -> Waypoints:

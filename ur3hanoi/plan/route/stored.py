@@ -12,7 +12,8 @@ geometry, the robot model and the planning settings alone. :func:`connect` keeps
 - **Key**: :func:`~ur3hanoi.plan.cache_key.station_inputs` (station geometry, robot model, Ruckig and NumPy
   versions, the planner's source), the planning limits, corridor, via grid, pass-through and blend settings, and
   the connection (slots and over heights): a changed input or a changed planner is a new entry, never a stale plan.
-- An entry that does not decode, or whose states Ruckig no longer connects, is rebuilt (see :func:`ur3hanoi.cache.cached`).
+- An entry that does not decode, or whose states Ruckig no longer connects, is rebuilt
+  (:func:`ur3hanoi.cache.cached`).
 """
 
 from __future__ import annotations
