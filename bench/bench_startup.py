@@ -9,8 +9,9 @@ Each command is a new process of this interpreter (`python -m ur3hanoi ...`, as 
 start to exit; figures are the median (and best) of N runs after one warm-up run, with the median CPU time (user +
 system) of the process. Byte code is cached as after an install (PYTHONDONTWRITEBYTECODE is dropped; the cache goes
 to a temporary PYTHONPYCACHEPREFIX), and the user's cache is a temporary XDG_CACHE_HOME: the first `plan` of a station
-fills it (the planner's connections and waypoints, the collision geometry; reported apart), the timed ones use it. Wall times on a shared machine grow with its load (printed beside them);
-the CPU time of a single-threaded command does not wait for a core (numpy's BLAS threads add to it, though).
+fills it (the planner's connections and waypoints, the collision geometry; reported apart), the timed ones use it.
+Wall times on a shared machine grow with its load (printed beside them); the CPU time of a single-threaded command
+does not wait for a core (the command keeps numpy's BLAS on one thread, see ur3hanoi/cli/__init__.py).
 """
 
 from __future__ import annotations
