@@ -61,7 +61,8 @@ def python_for(version: str) -> str | None:
 
 
 def env_dir(distro: str) -> Path:
-    cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    # The user's real cache (tests/conftest.py gives the rest of the suite a private one).
+    cache = Path(os.environ.get("UR3HANOI_RCLPY_CACHE") or os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
     return cache / "ur3hanoi" / f"rclpy-{distro}"
 
 
