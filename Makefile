@@ -6,7 +6,7 @@ VENV ?= .venv
 STAMP := $(VENV)/.installed
 export MUJOCO_GL ?= egl
 
-.PHONY: solve test venv lint bench tables docs clean lab
+.PHONY: solve test test-fast venv lint bench tables docs clean lab
 
 $(STAMP): pyproject.toml requirements.lock tools/ensure-system-deps.sh
 	@$(PY) -c 'import sys; ok = (3, 11) <= sys.version_info[:2] <= (3, 13); ok or print(f"ur3hanoi: error: Python {sys.version.split()[0]} ($(PY)) is not supported: use Python 3.11, 3.12 or 3.13, e.g. make PY=python3.12"); sys.exit(not ok)'
@@ -23,6 +23,10 @@ solve: $(STAMP)
 
 test: $(STAMP)
 	$(VENV)/bin/python -m pytest -q
+
+# The tests that run on the CPU clock alone (no ROS, DDS, wheel build or long simulation): about 2-4 minutes.
+test-fast: $(STAMP)
+	$(VENV)/bin/python -m pytest -q -m "not ros and not dds and not rclpy and not packaging and not slow"
 
 # Regenerate the shipped waypoint table from the two shipped calibrations (a test fails when it is stale).
 tables: $(STAMP)

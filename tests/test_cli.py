@@ -568,6 +568,7 @@ def test_a_video_named_like_an_ffmpeg_option_is_a_file(tmp_path: Path, monkeypat
     assert _listing(tmp_path) == ["-x.mp4"]
 
 
+@pytest.mark.ros
 @requires_ros
 def test_ros_station_report_dash_is_standard_output(tmp_path: Path) -> None:
     env = ros_env(free_port(), tmp_path)

@@ -56,6 +56,7 @@ def test_default_dds_configuration_is_loopback_only() -> None:
         cyclone_config("eth0'/><x")
 
 
+@pytest.mark.dds
 @requires_netns
 def test_ros2_solve_solves_on_the_ur3e_station_over_dds(tmp_path: Path) -> None:
     report = tmp_path / "report.json"
@@ -81,6 +82,7 @@ exit $CODE
     assert "ready on ROS_DOMAIN_ID 0 (loopback): ur3e_sim" in (tmp_path / "st.out").read_text()
 
 
+@pytest.mark.dds
 @requires_netns
 def test_bridge_timing_and_halt_on_a_missing_block_over_dds(tmp_path: Path) -> None:
     """Bridge timing: every move lasts 2 s; the top block removed: ros2-solve halts (exit 3), suction off, home."""
