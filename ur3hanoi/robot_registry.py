@@ -82,7 +82,9 @@ class RobotDescription:
 
 _SPEED = (math.pi,) * 3 + (2 * math.pi,) * 3  # 180 deg/s joints 1-3, 360 deg/s wrists (both datasheets)
 _ACC = (4.0,) * 3 + (8.0,) * 3
-_JERK = (20.0,) * 3 + (40.0,) * 3
+# [rad/s^3] each acceleration cap reached within one 8 ms CB3 servo cycle: ur3hanoi.robot.DEFAULT_JERK_MAX (its
+# source is written there; the merge of the robot registry had brought back the former 20/40 rad/s^3).
+_JERK = tuple(a / 0.008 for a in _ACC)
 
 UR3 = RobotDescription(
     name="ur3", title="UR3 (CB3)",
