@@ -8,9 +8,10 @@ an 18-pose IK table <= 1 ms.
 Each command is a new process of this interpreter (`python -m ur3hanoi ...`, as a fresh clone runs it), timed from
 start to exit; figures are the median (and best) of N runs after one warm-up run, with the median CPU time (user +
 system) of the process. Byte code is cached as after an install (PYTHONDONTWRITEBYTECODE is dropped; the cache goes
-to a temporary PYTHONPYCACHEPREFIX), and the user's cache is a temporary XDG_CACHE_HOME: the first `plan` fills it
-(reported apart), the timed ones use it. Wall times on a shared machine grow with its load (printed beside them);
-the CPU time of a single-threaded command does not wait for a core (numpy's BLAS threads add to it, though).
+to a temporary PYTHONPYCACHEPREFIX), and the user's cache is a temporary XDG_CACHE_HOME: the first `plan` of a station
+fills it (the planner's connections and waypoints, the collision geometry; reported apart), the timed ones use it.
+Wall times on a shared machine grow with its load (printed beside them); the CPU time of a single-threaded command
+does not wait for a core (the command keeps numpy's BLAS on one thread, see ur3hanoi/cli/__init__.py).
 """
 
 from __future__ import annotations
@@ -161,17 +162,17 @@ def main() -> int:
         for argv in ([], *([c] for c in commands)):
             walls = run.timed(["-m", "ur3hanoi", *argv, "--help"], args.runs)
             print(f"ur3hanoi {' '.join([*argv, '--help'])}: {summary(walls, HELP_TARGET_S)}")
-        plan_runs = max(3, args.runs // 2)
         warm_up = ["-m", "ur3hanoi", "plan", "--start", "1", "--end", "3"]
         run.once(warm_up, XDG_CACHE_HOME=str(Path(tmp_name) / "throwaway"))  # byte code only, not the user cache
         for station in ("lab_sim", "lab_real"):
             argv = ["-m", "ur3hanoi", "plan", "--start", "1", "--end", "3", "--calibration", station]
-            first = run.once(argv)  # lab_sim: empty user cache; lab_real: same robot and tool, so already filled
+            first = run.once(argv)  # nothing of this station in the user cache yet (the robot's geometry may be)
             print(f"cold ur3hanoi plan --start 1 --end 3 --calibration {station}: "
-                  f"{summary(run.timed(argv, plan_runs, warm_up=False), PLAN_TARGET_S)}; first run {first.wall:.3f} s"
-                  + (" (empty user cache)" if station == "lab_sim" else ""))
+                  f"{summary(run.timed(argv, args.runs, warm_up=False), PLAN_TARGET_S)} with its entries in the "
+                  f"user cache; first run (nothing of the station cached) wall {first.wall:.3f} s, "
+                  f"CPU {first.cpu:.3f} s")
         out = str(Path(tmp_name) / "lab2_data.yaml")
-        walls = run.timed(["-m", "ur3hanoi", "tables", "lab_sim", "--key", "sim_pos", "-o", out], plan_runs)
+        walls = run.timed(["-m", "ur3hanoi", "tables", "lab_sim", "--key", "sim_pos", "-o", out], args.runs)
         print(f"ur3hanoi tables lab_sim --key sim_pos -o FILE: {summary(walls, TABLES_TARGET_S)}")
     for name in ("lab_sim", "lab_real"):
         for line in bench_ik_station(name, repeats=max(20, args.runs * 20)):

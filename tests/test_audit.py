@@ -376,6 +376,11 @@ def test_check_against_a_calibration_is_strict_and_explains(lab_real: Station, t
     assert "(tolerance 1 mm / 0.5 deg); likely a typo in joint 4 (wrist 1)" in report.suspects[0].reason
     assert [e.status for e in report.entries].count("missing") == 1 and report.points_used == 17
     assert report.text().splitlines()[-1].startswith("16/17 entries within 1.0 mm / 0.5 deg (worst ")
+    for e in report.entries:  # the measured point and the calibration's, as a plot draws them
+        if e.status != "missing":
+            target = T_world_tcp(lab_real, e.tower, e.height, e.k).translation
+            assert np.allclose(e.fitted_m, target, atol=1e-12)
+            assert 1e3 * math.dist(e.point_m, e.fitted_m) == pytest.approx(e.error_mm, abs=1e-9)
 
 
 def test_json_has_the_documented_shape_and_every_threshold(tmp_path: Path) -> None:

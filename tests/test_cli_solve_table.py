@@ -38,7 +38,8 @@ def test_the_summary_says_which_table_was_followed(course_like: Path, capsys: py
     assert cli.main(["solve", "--start", "2", "--end", "1", "--blocks", "2", "--table", str(course_like),
                      "--key", "sim_pos", "--calibration", "lab_sim"]) == 0
     first = capsys.readouterr().out.splitlines()[0]
-    assert first == f"solved: 3/3 moves, tower 2 -> 1, 2 blocks on lab_sim, following {course_like}:sim_pos"
+    assert first == (f"solved: 3/3 moves, tower 2 -> 1, 2 blocks on lab_sim, following {course_like}:sim_pos "
+                     "(suction profile lab_sim)")
 
 
 def test_a_table_entry_15_mm_off_exits_3_naming_it(lab_sim: Station, tmp_path: Path,

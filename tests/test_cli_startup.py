@@ -78,4 +78,5 @@ def test_python_m_ur3hanoi_is_the_command() -> None:
     proc = subprocess.run([sys.executable, "-m", "ur3hanoi", "plan", "--blocks", "0"], capture_output=True,
                           text=True, cwd=REPO, timeout=60)
     assert proc.returncode == 2
-    assert proc.stderr.startswith("ur3hanoi plan: error: argument --blocks:"), proc.stderr
+    assert proc.stderr.startswith("ur3hanoi: error: argument --blocks:"), proc.stderr
+    assert "ur3hanoi plan --help" in proc.stderr

@@ -10,15 +10,7 @@ from xml.etree import ElementTree
 import pytest
 
 from ur3hanoi import robot as ur3
-from ur3hanoi.robot_registry import (
-    ROBOTS,
-    UR3,
-    UR3E,
-    DHParameters,
-    RobotDescription,
-    check_description,
-    robot_description,
-)
+from ur3hanoi.robot_registry import ROBOTS, UR3, UR3E, DHParameters, check_description, robot_description
 from ur3hanoi.robot_urdf import ur_layout
 
 
@@ -49,12 +41,6 @@ def test_ur3e_dh_is_urs_published_table() -> None:
 def test_ur3_entry_is_the_module_constants() -> None:
     assert (UR3.dh.d, UR3.dh.a, UR3.dh.alpha) == (ur3.DH_D, ur3.DH_A, ur3.DH_ALPHA)
     assert ur3.JointLimits.for_robot(UR3) == ur3.JointLimits.ur3()
-
-
-@pytest.mark.parametrize("robot", [UR3, UR3E], ids=["ur3", "ur3e"])
-def test_every_robot_plans_with_the_grounded_jerk_limit(robot: RobotDescription) -> None:
-    """The planner's jerk limits are ur3hanoi.robot.DEFAULT_JERK_MAX (the registry once brought back 20/40)."""
-    assert robot.j_max == pytest.approx(ur3.DEFAULT_JERK_MAX, rel=1e-12)
 
 
 def test_ur_layout_of_the_ur3_table_is_example_robot_datas_urdf() -> None:

@@ -28,7 +28,7 @@ import re
 import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 from ur3hanoi import __version__
 from ur3hanoi.errors import Ur3HanoiError
@@ -96,6 +96,33 @@ def store(kind: str, key: str, payload: bytes) -> bool:
     except (OSError, Ur3HanoiError):
         return False
     return True
+
+
+T = TypeVar("T")
+
+
+def cached(kind: str, inputs: Iterable[bytes], build: Callable[[], T], encode: Callable[[T], bytes | None],
+           decode: Callable[[bytes], T | None]) -> T:
+    """The value of entry (``kind``, key of ``inputs``) through ``decode``, else ``build()``, kept through
+    ``encode`` for the next process.
+
+    ``decode`` returns None (or raises) for a payload it does not accept: such an entry is rebuilt and
+    overwritten. ``encode`` returns None for a value not to be kept.
+    """
+    key = content_key(kind, inputs)
+    payload = load(kind, key)
+    if payload is not None:
+        try:
+            value = decode(payload)
+        except Exception:  # whatever a payload that is not this kind's makes a decoder raise: rebuild it
+            value = None
+        if value is not None:
+            return value
+    value = build()
+    data = encode(value)
+    if data is not None:
+        store(kind, key, data)
+    return value
 
 
 # ----------------------------------------------------------------------------------------- cached kinds

@@ -27,7 +27,7 @@ import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
-from ur3hanoi.robot_registry import UR3, DHParameters, RobotDescription
+from ur3hanoi.robot_registry import CB3_CONTROL_PERIOD_S, UR3, DHParameters, RobotDescription
 
 JOINT_NAMES: tuple[str, ...] = (
     "shoulder_pan_joint",
@@ -52,9 +52,9 @@ Q_HOME_LAB: tuple[float, ...] = tuple(math.radians(d) for d in (120.0, -90.0, 90
 
 
 # [rad/s^2] Acceleration caps (joints 1-3, wrists): not published by UR; the lab's values (see JointLimits.a_max).
-DEFAULT_ACCEL_MAX: tuple[float, ...] = (4.0,) * 3 + (8.0,) * 3
+DEFAULT_ACCEL_MAX: tuple[float, ...] = UR3.a_max
 # [s] The CB3 controller's servo cycle (125 Hz).
-CONTROL_PERIOD_S = 0.008
+CONTROL_PERIOD_S = CB3_CONTROL_PERIOD_S
 # [rad/s^3] Jerk limits: each acceleration cap reached within one servo cycle, a_max / 8 ms = 500 rad/s^3 (joints
 # 1-3) and 1000 rad/s^3 (wrists). Source: UR publishes no jerk limit and the controller's movej steps its
 # acceleration, which at 125 Hz is exactly such a one-cycle ramp: a planner with a lower jerk is slower than the
@@ -62,7 +62,7 @@ CONTROL_PERIOD_S = 0.008
 # this costs the carried block is measured by bench/bench_suction_hold.py (bench/REPORT.md): in MuJoCo the suction
 # weld stretches at most 0.64 mm on lab_sim and 0.27 mm on lab_real at 100-2000 rad/s^3, against the 10 mm at
 # which the seal counts as broken (SuctionConfig.hold_tolerance): a margin above 15.
-DEFAULT_JERK_MAX: tuple[float, ...] = tuple(a / CONTROL_PERIOD_S for a in DEFAULT_ACCEL_MAX)
+DEFAULT_JERK_MAX: tuple[float, ...] = UR3.j_max  # = a_max / CONTROL_PERIOD_S (the registry's UR3 entry)
 
 
 @dataclass(frozen=True)

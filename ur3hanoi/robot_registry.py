@@ -82,9 +82,12 @@ class RobotDescription:
 
 _SPEED = (math.pi,) * 3 + (2 * math.pi,) * 3  # 180 deg/s joints 1-3, 360 deg/s wrists (both datasheets)
 _ACC = (4.0,) * 3 + (8.0,) * 3
-# [rad/s^3] each acceleration cap reached within one 8 ms CB3 servo cycle: ur3hanoi.robot.DEFAULT_JERK_MAX (its
-# source is written there; the merge of the robot registry had brought back the former 20/40 rad/s^3).
-_JERK = tuple(a / 0.008 for a in _ACC)
+CB3_CONTROL_PERIOD_S = 0.008
+"""[s] The CB3 controller's servo cycle (125 Hz)."""
+# [rad/s^3] Each acceleration cap reached within one CB3 servo cycle: 500 / 1000 rad/s^3. UR publishes no jerk
+# limit; the source and what it costs the carried block are written at ur3hanoi.robot.DEFAULT_JERK_MAX. The UR3e
+# keeps the same value: the simulated suction hold that grounds it was measured up to 2000 rad/s^3 on the UR3.
+_JERK = tuple(a / CB3_CONTROL_PERIOD_S for a in _ACC)
 
 UR3 = RobotDescription(
     name="ur3", title="UR3 (CB3)",

@@ -1,6 +1,7 @@
 """Audit against a calibration's intended poses (generated tables), and the report of a calibration fit.
 
-- :func:`check_against`: each entry's FK suction point and tool orientation against the station's intended pose;
+- :func:`check_against`: each entry's FK suction point and tool orientation against the station's intended pose
+  (both points kept on the entry, as ``point_m`` and ``fitted_m``);
   an entry is suspect over fixed tolerances, by default :data:`~ur3hanoi.audit.report.STRICT_MM` /
   :data:`~ur3hanoi.audit.report.STRICT_DEG` (1 mm / 0.5 deg): a generated table reproduces its grid to 1e-9 m.
 - :func:`report_from_fit` / :func:`audit_taught`: the report of :func:`ur3hanoi.calibrate.fit_station` (``calibrate
@@ -92,7 +93,8 @@ def check_against(table: RecordedTable, station: Station, tol_mm: float = STRICT
         if s in status:
             st, i = status[s]
             entries.append(AuditEntry(*s, field=fields[i], error_mm=float(err_mm[i]), rot_deg=float(rot[i]),
-                                      tilt_deg=float(m.tilt_deg[i]), status=st))
+                                      tilt_deg=float(m.tilt_deg[i]), status=st, q=tuple(float(v) for v in qs[i]),
+                                      point_m=_xyz(m.p_world[i]), fitted_m=_xyz(targets[i])))
         else:
             entries.append(AuditEntry(*s, field=f"{table.key}[{s[0]}][{s[1]}][{s[2]}]", error_mm=math.nan,
                                       rot_deg=math.nan, tilt_deg=math.nan, status="missing"))
@@ -102,6 +104,11 @@ def check_against(table: RecordedTable, station: Station, tol_mm: float = STRICT
                        thresholds=Thresholds(mm=tol_mm, deg=tol_deg, sigma_mm=math.nan, sigma_deg=math.nan,
                                              derived=False),
                        shared_above=table.shared_above)
+
+
+def _xyz(v: np.ndarray) -> tuple[float, float, float]:
+    """A point [m] as the three floats of :attr:`AuditEntry.point_m`."""
+    return float(v[0]), float(v[1]), float(v[2])
 
 
 def default_base(key: str) -> str:

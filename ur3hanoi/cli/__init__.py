@@ -5,6 +5,13 @@ numeric option's range, :mod:`~ur3hanoi.cli.exit_codes` the exit codes and which
 :mod:`~ur3hanoi.cli.main` the entry point that turns every error into one line on stderr.
 """
 
+import os
+
+# NumPy's OpenBLAS starts a busy-waiting thread per core when it is imported: on a shared 2-core machine that is up
+# to 0.1 s of CPU at every start, for 6x6 matrices that never use the threads. The command keeps BLAS on one thread
+# unless the user chose otherwise (set before anything imports NumPy).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 from ur3hanoi.cli.main import build_parser, help_markdown, main
 from ur3hanoi.cli.solve import prompt_tower
 

@@ -43,7 +43,8 @@ def add(sub: argparse._SubParsersAction) -> None:
                    help="print one JSON object: entries, suspects, warnings, fit (with --fit: the rule's thresholds)")
     p.add_argument("--plot", metavar="FILE",
                    help="draw the audit into FILE (.png, .svg or .pdf): top and side views of the recorded suction "
-                        "points against the reference towers, suspects marked and labelled (needs the plot extra)")
+                        "points against where the audit puts them, flagged entries marked and labelled, warned ones "
+                        "in orange (needs the plot extra)")
     p.set_defaults(func=run)
 
 
@@ -73,10 +74,8 @@ def run(args: argparse.Namespace) -> int:
         tol_deg = STRICT_DEG if args.tol_deg is None else args.tol_deg
         report = check_against(table, station, tol_mm, tol_deg)
     if args.plot:
-        from ur3hanoi.plots.audit import fitted_reference, write_audit_plot
+        from ur3hanoi.plots.audit import write_audit_plot
 
-        grid = fitted_reference(table, base, args.tol_mm, args.tol_deg) if args.fit else station
-        write_audit_plot(args.plot, report, table, grid, title=f"{table.source}: {report.reference}",
-                         inputs=(Path(args.file),))
+        write_audit_plot(args.plot, report, title=f"{table.source}: {report.reference}", inputs=(Path(args.file),))
     print(json.dumps(report.to_json()) if args.json else report.text())
     return exit_codes.OVER_TOLERANCE if report.failed else exit_codes.OK

@@ -18,7 +18,7 @@ from typing import Any
 
 from ur3hanoi.errors import MISSING, InputError, printable, quote
 from ur3hanoi.io.limits import MAX_LIST_ITEMS
-from ur3hanoi.io.yaml_loader import Yaml11Reading
+from ur3hanoi.io.yaml11 import Yaml11Reading
 
 
 def _fmt(x: float) -> str:

@@ -35,23 +35,9 @@ from yaml.nodes import MappingNode, Node, ScalarNode
 from ur3hanoi.errors import InputError, printable, quote
 from ur3hanoi.io.limits import MAX_ALIASES, MAX_DEPTH, MAX_INT_DIGITS, MAX_NODES
 from ur3hanoi.io.reading import read_input_bytes
+from ur3hanoi.io.yaml11 import Yaml11Reading
 
 _MERGE_TAG = "tag:yaml.org,2002:merge"
-
-
-@dataclass(frozen=True)
-class Yaml11Reading:
-    """A plain scalar YAML 1.1 reads as something else than it looks: ``text`` as written, ``value`` the YAML 1.1
-    reading (8 for ``010``, 90 for ``1:30``, True for ``on``), ``meaning`` that reading in words, ``line``
-    1-based. Its ``repr`` is the source text, so messages quote what the file says."""
-
-    text: str
-    value: Any
-    meaning: str
-    line: int
-
-    def __repr__(self) -> str:
-        return self.text
 
 
 _YAML11_BOOLS = frozenset({"yes", "no", "on", "off"})

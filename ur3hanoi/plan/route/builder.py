@@ -31,6 +31,7 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.grid import block_center_world, contact_point_world
 from ur3hanoi.hanoi import Move, stacks_before_moves
 from ur3hanoi.plan.motion.legs import Leg, State
+from ur3hanoi.plan.route import stored
 from ur3hanoi.plan.route.connections import Connection, StationPlanner, station_planner
 from ur3hanoi.plan.types import Phase, PlanConfig, Segment
 from ur3hanoi.robot import N_JOINTS
@@ -143,7 +144,7 @@ class SegmentBuilder:
         self.legs_used.append(leg)
 
     def _hop(self, chain: _Chain, hop: Hop) -> Connection:
-        c = self.planner.connect(hop.slot0, hop.slot1, hop.over0, hop.over1)
+        c = stored.connect(self.planner, hop.slot0, hop.slot1, hop.over0, hop.over1)
         if c.exit is not None and hop.slot0 is not None:
             self._leg(chain, hop.exit_step, c.exit, hop.slot0, down=False)
         n = len(c.across)

@@ -39,6 +39,7 @@ from ur3hanoi.robot import N_JOINTS, load_ur3
 from ur3hanoi.station import Station
 
 Slot = tuple[int, int]  # (tower, height), 0-based
+ConnectionKey = tuple[Slot | None, Slot | None, float | None, float | None]  # slot0, slot1, over0, over1
 
 # Start of the via search, in the grid's units (vb, vb / T0): near the optimum of the lab stations' connections.
 SEARCH_START = (2.0, 1.0)
@@ -91,7 +92,7 @@ class StationPlanner:
         self.via_speeds = via_speeds if pass_through else (0.0,)
         self.via_accels = via_accels if pass_through else (0.0,)
         self._slots: dict[Slot, SlotLegs] = {}
-        self._connections: dict[tuple[Slot | None, Slot | None, float | None, float | None], Connection] = {}
+        self._connections: dict[ConnectionKey, Connection] = {}
         self._over: dict[tuple[Slot, float], FloatArray] = {}
         self._rest: dict[tuple[bytes, bytes], float] = {}
         self._exact_leg: dict[Slot, float] = {}
@@ -142,6 +143,14 @@ class StationPlanner:
         if key not in self._connections:
             self._connections[key] = self._connect(*key)
         return self._connections[key]
+
+    def memoized(self, key: ConnectionKey) -> Connection | None:
+        """The connection of ``key`` (slot0, slot1, over0, over1) if this planner has it already, else None."""
+        return self._connections.get(key)
+
+    def memoize(self, key: ConnectionKey, connection: Connection) -> None:
+        """Keep a connection of ``key`` obtained elsewhere (:mod:`ur3hanoi.plan.route.stored`, the user's cache)."""
+        self._connections[key] = connection
 
     def _connect(self, slot0: Slot | None, slot1: Slot | None, over0: float | None,
                  over1: float | None) -> Connection:

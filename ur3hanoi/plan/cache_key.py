@@ -1,0 +1,40 @@
+"""What a planner result kept in the user's cache (:mod:`ur3hanoi.cache`) depends on: the inputs of its key.
+
+:func:`station_inputs`: the station geometry (the :class:`~ur3hanoi.station.Station` value without its name and
+file, every float by ``repr``, so the same value is the same key and any changed field a new one), the robot model
+(its URDF text with the tool frame), the Ruckig and NumPy versions (their arithmetic makes the numbers), and the
+planner's own source (the ``ur3hanoi.plan`` package and the top-level modules, by content): a changed input or a
+changed planner is a new entry, never a stale result.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ur3hanoi.robot import load_ur3
+from ur3hanoi.station import Station
+
+_PACKAGE = Path(__file__).resolve().parents[1]  # ur3hanoi/
+
+
+@lru_cache(maxsize=1)
+def source_digest() -> bytes:
+    """sha256 of the planner's source: every module of the ``ur3hanoi.plan`` package and the top-level modules."""
+    h = hashlib.sha256()
+    for path in [*sorted((_PACKAGE / "plan").rglob("*.py")), *sorted(_PACKAGE.glob("*.py"))]:
+        h.update(path.relative_to(_PACKAGE).as_posix().encode() + b"\0")
+        h.update(hashlib.sha256(path.read_bytes()).digest())
+    return h.digest()
+
+
+@lru_cache(maxsize=16)
+def station_inputs(station: Station) -> tuple[bytes, ...]:
+    """The key inputs of everything cached for ``station`` (pass its geometry, see the module docstring)."""
+    import ruckig
+
+    return (f"ruckig {ruckig.__version__}, numpy {np.__version__}".encode(), source_digest(),
+            repr(station).encode(), load_ur3(station.tool, station.limits, station.robot).urdf.encode())
