@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Iterator
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -65,10 +66,12 @@ def test_eight_blocks_on_a_tall_grid_execute(lab_real: Station) -> None:
 
 
 @pytest.fixture
-def no_place_band(monkeypatch: pytest.MonkeyPatch) -> Iterator[float]:
+def no_place_band(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> Iterator[float]:
     """The placing band switched off (any distance from the line allowed just above contact); yields the shipped
-    tolerance. The cached station planners (they hold the legs built under the rule) are dropped before and after."""
+    tolerance. The cached station planners (they hold the legs built under the rule) are dropped before and after,
+    and the user's cache is a private one: its keys hold the planner's source, not a patched constant."""
     shipped = vertical.PLACE_TOL_M
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     connections._cached_planner.cache_clear()
     monkeypatch.setattr(vertical, "PLACE_TOL_M", 1.0)
     yield shipped
