@@ -72,7 +72,7 @@ def test_a_single_joint_segment_leaves_the_line(lab_real: Station) -> None:
     legs, _ = _slot_legs(lab_real, (2, 1))
     single = legs.ruckig.solve(*legs.above_state(legs.rest_cell, True), *legs.on).trajectory
     assert single is not None
-    dev, _ = legs.corridor([single])
+    dev, _, _ = legs.corridor([single])
     assert dev > 0.004
 
 

@@ -102,8 +102,9 @@ class Blender:
             top = trial((lam * x[0], lam * x[1]))[1]
             if top is None:
                 return None
-            dev, dip = legs.corridor([top])
-            return dev if dev <= self.tol_m - DENSE_MARGIN_M and dip <= CONTACT_OVERSHOOT_M else None
+            dev, dip, near = legs.corridor([top])
+            ok = dev <= self.tol_m - DENSE_MARGIN_M and dip <= CONTACT_OVERSHOOT_M and legs.near_ok(near)
+            return dev if ok else None
 
         dev = fits(1.0)
         if dev is None:  # cut back along the ray to the largest scale that fits (bisection)

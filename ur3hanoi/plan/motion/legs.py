@@ -54,7 +54,7 @@ from ur3hanoi.plan.kinematics import tcp_positions_world
 from ur3hanoi.plan.motion.minimize import nelder_mead
 from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 from ur3hanoi.plan.motion.sampling import evaluate
-from ur3hanoi.plan.motion.vertical import PathLimits, VerticalPath
+from ur3hanoi.plan.motion.vertical import PathLimits, VerticalPath, place_band
 from ur3hanoi.plan.types import KinematicLimits
 from ur3hanoi.plan.waypoints import Waypoints
 from ur3hanoi.station import Station
@@ -140,6 +140,7 @@ class SlotLegs:
         contact = contact_point_world(station, *slot)
         self.line_xy = contact[:2]
         self.z_on = float(contact[2])
+        self.band = place_band(slot[1])  # placing onto a stack: close to the line just above contact
         rest = ruckig.solve(self.q_above, zero, zero, *self.on)
         if rest.trajectory is None:
             raise PlanError(f"Ruckig failed on the rest-to-rest leg of slot {slot}: {rest.reason}")
@@ -294,21 +295,24 @@ class SlotLegs:
             chain = self.ruckig.chain(states)
             if chain is None:
                 return None, False
-            dev, dip = self.corridor(chain)
+            dev, dip, near = self.corridor(chain)
             if dip > CONTACT_OVERSHOOT_M:
                 return None, True
             if dev > self.tol_m - DENSE_MARGIN_M:  # far off (not at rest): braking too late, more points won't help
                 return None, cell != self.rest_cell and dev > 2.0 * self.tol_m
+            if down and not self.near_ok(near):  # closing in on the line at contact: more points may straighten it
+                return None, False
             legs.append(Leg(tuple(states), tuple(chain), sum(t.duration for t in chain), dev))
         return (legs[0], legs[1]), False
 
-    def _verified(self, states: Sequence[State]) -> Leg | None:
-        """The chained leg through ``states`` if Ruckig solves it and it passes the corridor check, else None."""
+    def _verified(self, states: Sequence[State], down: bool) -> Leg | None:
+        """The chained leg through ``states`` if Ruckig solves it and it passes the corridor check (and, descending,
+        the placing band's), else None."""
         chain = self.ruckig.chain(states)
         if chain is None:
             return None
-        dev, dip = self.corridor(chain)
-        if dip > CONTACT_OVERSHOOT_M or dev > self.tol_m - DENSE_MARGIN_M:
+        dev, dip, near = self.corridor(chain)
+        if dip > CONTACT_OVERSHOOT_M or dev > self.tol_m - DENSE_MARGIN_M or (down and not self.near_ok(near)):
             return None
         return Leg(tuple(states), tuple(chain), sum(t.duration for t in chain), dev)
 
@@ -338,9 +342,10 @@ class SlotLegs:
                 mid.append((q, sd[i] * dq, sd[i] * sd[i] * ddq + sdd[i] * dq))
             if not all(within_limits(m, self.limits) for m in mid):
                 continue
-            down = self._verified([self.above_state(cell, down=True), *mid, self.on])
+            down = self._verified([self.above_state(cell, down=True), *mid, self.on], down=True)
             rev = [(q, -v, a) for q, v, a in mid[::-1]]
-            up = self._verified([self.on, *rev, self.above_state(cell, down=False)]) if down is not None else None
+            up = (self._verified([self.on, *rev, self.above_state(cell, down=False)], down=False) if down is not None
+                  else None)
             if down is not None and up is not None:
                 return down, up
         return None
@@ -348,14 +353,21 @@ class SlotLegs:
     def _path_limits(self) -> PathLimits:
         return PathLimits.for_path(self.path, self.limits)
 
-    def corridor(self, chain: Sequence[RuckigTrajectory]) -> tuple[float, float]:
-        """(worst distance [m] from the vertical line, deepest dip [m] below the contact pose) of chained joint
+    def near_ok(self, near: float) -> bool:
+        """True when the worst distance from the line within the slot's placing band (``near`` [m]) is allowed."""
+        return self.band is None or near <= self.band[1] - DENSE_MARGIN_M
+
+    def corridor(self, chain: Sequence[RuckigTrajectory]) -> tuple[float, float, float]:
+        """(worst distance [m] from the vertical line, deepest dip [m] below the contact pose, worst distance [m]
+        from the line within the slot's placing band above the contact pose, 0 without a band) of chained joint
         trajectories, by forward kinematics at :data:`DENSE_RATE_HZ` (each segment from its start, and its end)."""
         q = np.concatenate([evaluate(t, np.append(np.arange(0.0, t.duration, 1.0 / DENSE_RATE_HZ), t.duration))[0]
                             for t in chain])
         p = tcp_positions_world(self.station, q)
-        dev = float(np.max(np.hypot(p[:, 0] - self.line_xy[0], p[:, 1] - self.line_xy[1])))
-        return dev, max(0.0, self.z_on - float(np.min(p[:, 2])))
+        d = np.hypot(p[:, 0] - self.line_xy[0], p[:, 1] - self.line_xy[1])
+        low = p[:, 2] <= self.z_on + self.band[0] if self.band is not None else np.zeros(len(d), dtype=bool)
+        near = float(np.max(d[low])) if np.any(low) else 0.0
+        return float(np.max(d)), max(0.0, self.z_on - float(np.min(p[:, 2]))), near
 
     def _exact_path_legs(self) -> tuple[Leg, Leg]:
         """Rest-to-rest legs following the line exactly: a 1-DoF Ruckig of s under :class:`PathLimits`."""

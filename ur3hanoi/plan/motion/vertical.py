@@ -30,6 +30,27 @@ from ur3hanoi.station import Station
 
 FD_STEP_M = 1e-3  # [m] finite-difference step of the higher path derivatives
 
+# Placing onto a stack: the last PLACE_BAND_M [m] above the contact pose within PLACE_TOL_M [m] of the vertical line
+# (descend legs, 1 kHz, less legs.DENSE_MARGIN_M), for every slot at 0-based height >= PLACE_MIN_HEIGHT (a block
+# below). Why: the simulated arm tracks the plan within ~0.25 mm and dips that far below the contact pose as it
+# stops, so the carried block touches the stack while the suction point still closes in on the line; pressed down
+# (0.6-0.75 N, three times its weight) and dragged sideways by friction, it tilts the stack below by ~0.4 deg, and
+# on release the stack springs back and throws the block ~0.6 mm off. Measured on a tall grid (8 levels, 7 blocks,
+# bench/bench_executes.py's): legs within 0.45-0.57 mm of the line in their last 0.5 mm shifted the released block
+# by 0.01-0.12 mm per placement, legs at 0.75 and 0.87 mm by 0.58 and 0.35 mm, and tower 1 height 3, placed on 15
+# times, drove the top block 8.1 mm off (final check 5 mm). The lab stations' descend legs come within 0.16-0.48 mm
+# (lab_real tower 1 height 3 the most), so their plans are unchanged (bit-identical samples). On the table
+# (height 0) nothing below can tilt: no band.
+PLACE_BAND_M = 5e-4
+PLACE_TOL_M = 6e-4
+PLACE_MIN_HEIGHT = 1
+
+
+def place_band(height: int) -> tuple[float, float] | None:
+    """(band above the contact pose [m], allowed distance from the vertical line within it [m]) of a slot at 0-based
+    ``height``, or None where no stack is below (:data:`PLACE_BAND_M`, :data:`PLACE_TOL_M`)."""
+    return (PLACE_BAND_M, PLACE_TOL_M) if height >= PLACE_MIN_HEIGHT else None
+
 
 @dataclass(frozen=True)
 class VerticalPath:
