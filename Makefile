@@ -21,12 +21,16 @@ venv: $(STAMP)
 solve: $(STAMP)
 	$(VENV)/bin/ur3hanoi solve --start 1 --end 3
 
+# Tests on the CPU clock run on every core (pytest-xdist); the ones on the wall clock (ROS 1, DDS, rclpy) and the
+# wheel build run after them, one at a time, so that no other test takes their CPU.
+REALTIME := ros or dds or rclpy or packaging
 test: $(STAMP)
-	$(VENV)/bin/python -m pytest -q
+	$(VENV)/bin/python -m pytest -q -n auto -m "not ($(REALTIME))"
+	$(VENV)/bin/python -m pytest -q -m "$(REALTIME)"
 
-# The tests that run on the CPU clock alone (no ROS, DDS, wheel build or long simulation): about 2-4 minutes.
+# The tests that run on the CPU clock alone, without the long simulations.
 test-fast: $(STAMP)
-	$(VENV)/bin/python -m pytest -q -m "not ros and not dds and not rclpy and not packaging and not slow"
+	$(VENV)/bin/python -m pytest -q -n auto -m "not ($(REALTIME) or slow)"
 
 # Regenerate the shipped waypoint table from the two shipped calibrations (a test fails when it is stale).
 tables: $(STAMP)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import colorsys
 import json
+import math
 import re
 import shutil
 import subprocess
@@ -19,7 +20,7 @@ from PIL import Image
 from tests.sim_helpers import STATIONS, planned
 from ur3hanoi.errors import SuctionFaultError
 from ur3hanoi.replay import PoseRecorder, SinkTee, page_html, record_plan, write_plan_replay, write_run_replay
-from ur3hanoi.replay.timeline import timeline_of_plan
+from ur3hanoi.replay.timeline import FAULT_KINDS, timeline_of_plan
 from ur3hanoi.sim import Faults, build_task_scene, run_plan
 from ur3hanoi.sim.result import SimResult
 from ur3hanoi.sim.scene import BLOCK_RGBA, slot_centers
@@ -193,31 +194,41 @@ def _mask(img: np.ndarray, rgba: tuple[float, float, float, float]) -> np.ndarra
     return (dh < 12.0) & (hsv[..., 1] > 0.7 * 255) & (hsv[..., 2] > 0.25 * 255)
 
 
+def _end_of_move_3() -> float:
+    """A moment [s] at the end of move 3 (red tower 3 -> 2 placed, the arm back above it), read off the plan to
+    the 0.01 s the address gives, so the test follows the planner's timing."""
+    tr = planned("lab_sim", 0, 2).trajectory
+    last = int(np.flatnonzero(tr.move_index == 2)[-1])
+    return math.floor((float(tr.t[last]) - 0.05) * 100.0) / 100.0
+
+
 @pytest.fixture(scope="module")
-def browser_shots(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[float, np.ndarray], Path]:
+def browser_shots(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[float, np.ndarray], Path, float]:
     tmp = tmp_path_factory.mktemp("replay")
     result, rec, scene = dropped_run()
     page = tmp / "replay.html"
     write_run_replay(page, planned("lab_sim", 0, 2), scene, rec, result, "drop test")  # type: ignore[arg-type]
     shots = {}
-    for t in (0.0, 14.0):
+    t_mid = _end_of_move_3()
+    for t in (0.0, t_mid):
         name = f"t{t:g}"
         proc = _browse(f"{page.as_uri()}#t={t:g}", tmp, name, "screenshot")
         assert proc.returncode == 0, proc.stderr[-2000:]
         shots[t] = np.asarray(Image.open(tmp / f"{name}.png").convert("RGB"))[SCENE_ROWS]
-    return shots, page
+    halted = [e.t for e in result.feedback_events if e.kind in FAULT_KINDS]
+    return shots, page, float(min(halted))
 
 
 def test_browser_draws_the_arm_and_the_blocks_and_they_move(browser_shots) -> None:  # type: ignore[no-untyped-def]
-    shots, _ = browser_shots
-    a, b = shots[0.0], shots[14.0]
+    shots, _, _ = browser_shots
+    a, b = shots[0.0], shots[_end_of_move_3()]
     assert a.shape == b.shape == (370, 800, 3)
     centroids = {}
     for colour in ("green", "yellow", "red"):
         ma, mb = _mask(a, BLOCK_RGBA[colour]), _mask(b, BLOCK_RGBA[colour])
         assert ma.sum() > 40 and mb.sum() > 40, f"{colour} block not drawn: {ma.sum()} / {mb.sum()} px"
         centroids[colour] = (np.argwhere(ma).mean(axis=0), np.argwhere(mb).mean(axis=0))
-    # At 14 s (move 3 done, before the drop): red went tower 1 -> 2, yellow tower 1 -> 3, green stayed.
+    # At the end of move 3 (before the drop): red went tower 1 -> 2, yellow tower 1 -> 3, green stayed.
     moved = {c: float(np.linalg.norm(p1 - p0)) for c, (p0, p1) in centroids.items()}
     assert moved["red"] > 20 and moved["yellow"] > 20 and moved["green"] < 3, moved
     # The arm: the UR3's grey (0.7 under light: unsaturated mid-to-light grey) fills a large area, and moves.
@@ -231,15 +242,16 @@ def test_browser_draws_the_arm_and_the_blocks_and_they_move(browser_shots) -> No
 
 
 def test_browser_overlay_shows_the_moment_named_in_the_address(browser_shots, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
-    _, page = browser_shots
-    proc = _browse(f"{page.as_uri()}#t=14", tmp_path, "dom", "dump")
+    _, page, t_fault = browser_shots
+    t_mid = _end_of_move_3()
+    proc = _browse(f"{page.as_uri()}#t={t_mid:.2f}", tmp_path, "dom", "dump")
     assert proc.returncode == 0, proc.stderr[-2000:]
     dom = proc.stdout
-    assert re.search(r'id="ur3-time">14\.00 s / \d+\.\d\d s<', dom)
+    assert re.search(rf'id="ur3-time">{t_mid:.2f} s / \d+\.\d\d s<', dom)
     assert 'id="ur3-move">move 3/7: block 3 (red): tower 3 height 1 -&gt; tower 2 height 2<' in dom
-    assert re.search(r'id="ur3-fault"[^>]*>halted at 17\.\d\d s: suction fault in move 4/7', dom)
+    assert re.search(rf'id="ur3-fault"[^>]*>halted at {t_fault:.2f} s: suction fault in move 4/7', dom)
     assert 'id="ur3-play">Play<' in dom  # opened paused at the named moment
-    after = _browse(f"{page.as_uri()}#t=18", tmp_path, "dom18", "dump").stdout
+    after = _browse(f"{page.as_uri()}#t={t_fault + 0.2:.2f}", tmp_path, "dom18", "dump").stdout
     assert 'id="ur3-move">halted in move 4/7: the arm stops' in after
 
 

@@ -110,7 +110,10 @@ BAD_FIELDS = [
 ]
 
 
-@pytest.mark.parametrize(("field", "value", "match"), BAD_FIELDS, ids=[f"{f}={v!r}" for f, v, _ in BAD_FIELDS])
+_IDS = [f"{f}=<deleted>" if v is _DELETE else f"{f}={v!r}" for f, v, _ in BAD_FIELDS]  # the same in every process
+
+
+@pytest.mark.parametrize(("field", "value", "match"), BAD_FIELDS, ids=_IDS)
 def test_bad_field_names_file_field_value_and_range(field: str, value: Any, match: str) -> None:
     with pytest.raises(CalibrationError, match=match) as info:
         parse_station(_mutated(LAB_SIM, field, value), "bad.yaml")

@@ -124,6 +124,13 @@ def record_plan(plan: Plan, scene: TaskScene, fps: float = 30.0) -> PoseTrack:
         T[:3, 3] = d.xpos[body]
         return T
 
+    def _place(block: int, T_world_block: FloatArray) -> None:
+        adr = scene.block_qadr[block]
+        d.qpos[adr:adr + 3] = T_world_block[:3, 3]
+        quat = np.empty(4)
+        mujoco.mju_mat2Quat(quat, T_world_block[:3, :3].reshape(-1))
+        d.qpos[adr + 3:adr + 7] = quat
+
     for t, k in zip(times, samples, strict=True):
         # Walk the suction transitions between the previous frame's sample and this one.
         for j in range(k_done, k + 1):
@@ -135,17 +142,16 @@ def record_plan(plan: Plan, scene: TaskScene, fps: float = 30.0) -> PoseTrack:
                     held = block
                     rel = np.linalg.inv(pose(cup)) @ pose(scene.block_body[block])
             elif not suction[j] and held is not None:
+                # Put the block down where the cup releases it (not where it was at the last frame, which may lie
+                # before the arm reached the contact pose).
+                mujoco.mj_kinematics(m, d)
+                _place(held, pose(cup) @ rel)
                 held = None
         k_done = k + 1
         d.qpos[scene.arm_qadr] = tr.q[k]
         mujoco.mj_kinematics(m, d)
         if held is not None:
-            T = pose(cup) @ rel
-            adr = scene.block_qadr[held]
-            d.qpos[adr:adr + 3] = T[:3, 3]
-            quat = np.empty(4)
-            mujoco.mju_mat2Quat(quat, T[:3, :3].reshape(-1))
-            d.qpos[adr + 3:adr + 7] = quat
+            _place(held, pose(cup) @ rel)
             mujoco.mj_kinematics(m, d)
         d.time = float(t)
         rec(m, d)
