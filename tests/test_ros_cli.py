@@ -19,7 +19,7 @@ def error_line(capsys) -> str:
     (["ros-solve", "--start", "1"], "--start and --end are required when stdin is not a terminal (towers 1..3)"),
     (["ros-solve", "--start", "1", "--end", "3", "--key", "real_pos"], "--key is only used with --table"),
     (["ros-solve", "--start", "2", "--end", "2"], "start and end tower are both 2"),
-    (["ros-solve", "--start", "1", "--end", "4"], "end tower 4 is outside the grid: expected 1..3"),
+    (["ros-solve", "--start", "1", "--end", "4"], "--end 4 is invalid: expected a tower 1..3 (lab_sim has 3 towers)"),
     (["ros-solve", "--start", "1", "--end", "3", "--blocks", "4"], "4 blocks is invalid: expected 1..3"),
     (["ros-station", "--start", "4"], "start tower 4 is invalid: expected 1..3"),
     (["ros-station", "--remove-block", "5"], "removed block height 5 is invalid: expected 1..3"),
@@ -62,3 +62,14 @@ def test_prompt_repeats_like_the_lab_program(monkeypatch, capsys):
     out = capsys.readouterr().out
     assert out.count("Enter the end tower <2 or 3> ") == 4
     assert out.count("Please just enter the character 2 or 3") == 3
+
+
+@pytest.mark.parametrize(("command", "station"), [("ros-solve", "lab_sim"), ("ros2-solve", "ur3e_sim")])
+@pytest.mark.parametrize("option", ["--start", "--end"])
+def test_tower_ranges_are_the_stations(command, station, option, capsys, monkeypatch):
+    """`--start 0` names the station's 1..3, not the option's widest 1..10, and nothing is sent anywhere."""
+    monkeypatch.setattr("sys.stdin.isatty", lambda: False)
+    other = "--end" if option == "--start" else "--start"
+    assert main([command, option, "0", other, "2"]) == 2
+    expected = f"ur3hanoi: error: {option} 0 is invalid: expected a tower 1..3 ({station} has 3 towers)"
+    assert error_line(capsys) == expected

@@ -24,9 +24,10 @@ from ur3hanoi.cli.options import (
     MOVE,
     ROS_RATE,
     SEED,
-    TOWER,
     UsageError,
+    check_number,
     option,
+    station_number,
 )
 from ur3hanoi.cli.solve import prompt_tower
 
@@ -59,7 +60,7 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
                     "--report or stdout; everything else goes to stderr.")
     p.add_argument("--calibration", default=None, metavar="CAL",
                    help=f"station calibration YAML or shipped name (default {DEFAULT_CALIBRATION})")
-    p.add_argument("--start", type=option(TOWER), default=1, metavar="T",
+    p.add_argument("--start", type=station_number("a tower"), default=1, metavar="T",
                    help="tower the blocks are spawned on (default 1)")
     p.add_argument("--blocks", type=option(BLOCKS), default=None, metavar="N",
                    help="number of blocks (default: the grid's)")
@@ -139,8 +140,8 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
                     "the suction feedback (DIGIN bit 0) after every grasp and during every carry, and on a missing "
                     "or dropped block halts like the lab asks: suction off, arm home, error, exit 3. Without "
                     "--start/--end it prompts like the lab program. Towers are numbered from 1.")
-    p.add_argument("--start", type=option(TOWER), metavar="S", help="start tower (1-based)")
-    p.add_argument("--end", type=option(TOWER), metavar="E", help="destination tower (1-based)")
+    p.add_argument("--start", type=station_number("a tower"), metavar="S", help="start tower (1-based)")
+    p.add_argument("--end", type=station_number("a tower"), metavar="E", help="destination tower (1-based)")
     p.add_argument("--blocks", type=option(BLOCKS), default=None, metavar="N",
                    help="number of blocks (default: the table's)")
     p.add_argument("--table", metavar="FILE", help="lab-format table (lab2_data.yaml); default: IK of --calibration")
@@ -186,6 +187,9 @@ def _run_solve(args: argparse.Namespace) -> int:
     home = np.array(Q_HOME_LAB if station is None else station.q_home, dtype=float)
     n_towers, n_heights = Q.shape[0], Q.shape[1]
     n_blocks = n_heights if args.blocks is None else args.blocks
+    why = f"{station.name} has {n_towers} towers" if station is not None else f"the table has {n_towers} towers"
+    check_number("--start", args.start, n_towers, "a tower", why)
+    check_number("--end", args.end, n_towers, "a tower", why)
     if args.start is None or args.end is None:
         if not sys.stdin.isatty():
             raise UsageError("--start and --end are required when stdin is not a terminal "

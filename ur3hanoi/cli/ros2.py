@@ -22,9 +22,10 @@ from ur3hanoi.cli.options import (
     MOVE,
     ROS_RATE,
     SEED,
-    TOWER,
     UsageError,
+    check_number,
     option,
+    station_number,
 )
 from ur3hanoi.cli.solve import prompt_tower
 
@@ -64,7 +65,8 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
                     "report to --report or stdout.")
     p.add_argument("--calibration", default=None, metavar="CAL",
                    help=f"station calibration YAML or shipped name (default {DEFAULT_ROS2_CALIBRATION})")
-    p.add_argument("--start", type=option(TOWER), default=1, metavar="T", help="tower the blocks start on (default 1)")
+    p.add_argument("--start", type=station_number("a tower"), default=1, metavar="T",
+                   help="tower the blocks start on (default 1)")
     p.add_argument("--blocks", type=option(BLOCKS), default=None, metavar="N", help="number of blocks (default: all)")
     p.add_argument("--remove-block", type=option(HEIGHT), metavar="H",
                    help="fault injection: spawn without the block at height H")
@@ -111,8 +113,8 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
                     "(--table FILE --key, controller convention, or generated from --calibration), waits until "
                     "every joint is within 0.0008 rad, checks dig_in bit 0 after every grasp and during every "
                     "carry, and on a missing or dropped block halts: suction off, arm home, error, exit 3.")
-    p.add_argument("--start", type=option(TOWER), metavar="S", help="start tower (1-based)")
-    p.add_argument("--end", type=option(TOWER), metavar="E", help="destination tower (1-based)")
+    p.add_argument("--start", type=station_number("a tower"), metavar="S", help="start tower (1-based)")
+    p.add_argument("--end", type=station_number("a tower"), metavar="E", help="destination tower (1-based)")
     p.add_argument("--blocks", type=option(BLOCKS), default=None, metavar="N", help="number of blocks")
     p.add_argument("--table", metavar="FILE", help="lab-format table (controller convention); default: IK of "
                                                    "--calibration")
@@ -139,7 +141,7 @@ def _run_solve(args: argparse.Namespace) -> int:
 
     from ur3hanoi.errors import SuctionFaultError
     from ur3hanoi.hanoi import validate_instance
-    from ur3hanoi.labfile import read_table
+    from ur3hanoi.labfile import read_recorded_table
     from ur3hanoi.ros.errors import RosError
     from ur3hanoi.ros.solve import LabSolveConfig, run_lab_solve
     from ur3hanoi.ros2.client import Ros2Arm, Ros2ArmConfig
@@ -150,10 +152,15 @@ def _run_solve(args: argparse.Namespace) -> int:
     if args.table is None and args.key is not None:
         raise UsageError("--key is only used with --table (the table is generated from --calibration otherwise)")
     station = load_station(args.calibration or DEFAULT_ROS2_CALIBRATION)
-    Q = read_table(args.table, args.key or "sim_pos") if args.table is not None else generate_table(station).q
+    # The reader and the entry rule of `solve --table` and `ros-solve --table` (entries never visited may miss).
+    recorded = read_recorded_table(args.table, args.key or "sim_pos") if args.table is not None else None
+    Q = recorded.q if recorded is not None else generate_table(station).q
     home = np.array(station.q_home, dtype=float)
     n_towers, n_heights = Q.shape[0], Q.shape[1]
     n_blocks = n_heights if args.blocks is None else args.blocks
+    why = f"{station.name} has {n_towers} towers"
+    check_number("--start", args.start, n_towers, "a tower", why)
+    check_number("--end", args.end, n_towers, "a tower", why)
     if args.start is None or args.end is None:
         if not sys.stdin.isatty():
             raise UsageError("--start and --end are required when stdin is not a terminal "
@@ -163,6 +170,8 @@ def _run_solve(args: argparse.Namespace) -> int:
     else:
         start, end = args.start - 1, args.end - 1
     validate_instance(n_blocks, start, end, n_towers, n_heights)
+    if recorded is not None:
+        Q = recorded.for_solve(start, end, n_blocks)
     try:
         domain = domain_id_from_env() if args.domain_id is None else args.domain_id
     except ValueError as exc:
