@@ -6,8 +6,6 @@ from __future__ import annotations
 import base64
 import json
 import subprocess
-import sys
-import textwrap
 from pathlib import Path
 
 import coal
@@ -20,7 +18,7 @@ from ur3hanoi.cache import COLLISION_GEOMETRY, cache_dir, collision_geometry, co
 from ur3hanoi.robot import ToolOffset, Ur3Model, load_ur3
 from ur3hanoi.station import Station
 
-from .conftest import REPO
+from .cache_race import start_racer
 
 PAYLOAD = bytes(range(256)) * 1000  # every byte value, 256 kB
 
@@ -186,40 +184,19 @@ def test_corrupt_collision_entry_is_rebuilt(lab_sim: Station, private_cache: Pat
     assert len(calls) == 2  # the rebuilt entry is whole again
 
 
-_RACER = textwrap.dedent("""
-    import hashlib, os, sys, time
-    from pathlib import Path
+_RACE_BODY = """
     import numpy as np
-    import ur3hanoi.cache as cache
     from ur3hanoi.plan import CollisionScene
-    from ur3hanoi.station import load_station
-    real_load, real_store, first = cache.load, cache.store, []
-    def load(kind, key):
-        payload = real_load(kind, key)
-        first.append("hit" if payload is not None else "miss")
-        return payload
-    def store(kind, key, payload):
-        time.sleep(float(sys.argv[2]))  # hold the built entry back: the other process misses too
-        return real_store(kind, key, payload)
-    cache.load, cache.store = load, store
-    station = load_station("lab_sim")
-    ready, n_racers = Path(sys.argv[1]), int(sys.argv[3])
-    (ready / str(os.getpid())).touch()
-    deadline = time.monotonic() + 60
-    while len(list(ready.iterdir())) < n_racers and time.monotonic() < deadline:  # all racers start together
-        time.sleep(0.001)
     scene = CollisionScene(station, 3)
     scene.place_blocks({0: (0, 0), 1: (1, 0), 2: (2, 0)})
     q = np.array([2.0, -1.2, 1.3, -1.7, -1.57, 0.4])
     d = scene.distances(q, [(g, scene.table) for g in scene.robot_geoms] + [(scene.cup, b) for b in scene.blocks])
-    print(first[0], hashlib.sha256(d.tobytes()).hexdigest())
-""")
+    print(cache_events[0][0], hashlib.sha256(d.tobytes()).hexdigest())
+"""
 
 
 def _racer(ready: Path, hold_s: float, n_racers: int) -> subprocess.Popen[str]:
-    ready.mkdir(exist_ok=True)
-    return subprocess.Popen([sys.executable, "-c", _RACER, str(ready), str(hold_s), str(n_racers)], cwd=REPO,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return start_racer(_RACE_BODY, ready, hold_s, n_racers)
 
 
 def test_two_processes_racing_on_an_empty_cache(private_cache: Path, tmp_path: Path) -> None:

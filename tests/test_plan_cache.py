@@ -8,8 +8,6 @@ import base64
 import hashlib
 import json
 import subprocess
-import sys
-import textwrap
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -23,7 +21,7 @@ from ur3hanoi.plan.route.stored import CONNECTION
 from ur3hanoi.plan.waypoints import WAYPOINTS
 from ur3hanoi.station import Station
 
-from .conftest import REPO
+from .cache_race import start_racer
 
 
 @pytest.fixture(autouse=True)
@@ -114,39 +112,18 @@ def test_corrupt_or_foreign_entries_are_rebuilt(lab_sim: Station, private_cache:
     assert {e: e.read_bytes() for e in entries} == originals  # rebuilt, whole again
 
 
-_RACER = textwrap.dedent("""
-    import hashlib, os, sys, time
-    from pathlib import Path
-    import ur3hanoi.cache as cache
+_RACE_BODY = """
     from ur3hanoi.plan import plan_solve
-    from ur3hanoi.station import load_station
-    real_load, real_store, misses = cache.load, cache.store, []
-    def load(kind, key):
-        payload = real_load(kind, key)
-        if payload is None:
-            misses.append(kind)
-        return payload
-    def store(kind, key, payload):
-        time.sleep(float(sys.argv[2]))  # hold the built entry back: the other process misses too
-        return real_store(kind, key, payload)
-    cache.load, cache.store = load, store
-    station = load_station("lab_sim")
-    ready, n_racers = Path(sys.argv[1]), int(sys.argv[3])
-    (ready / str(os.getpid())).touch()
-    deadline = time.monotonic() + 60
-    while len(list(ready.iterdir())) < n_racers and time.monotonic() < deadline:  # all racers start together
-        time.sleep(0.001)
     plan = plan_solve(station, 0, 2, 2)
     tr = plan.trajectory
     digest = hashlib.sha256(b"".join(x.tobytes() for x in (tr.t, tr.q, tr.qd, tr.qdd, tr.qddd))).hexdigest()
-    print(len([m for m in misses if m.startswith("plan-")]), digest, "scipy" if "scipy" in sys.modules else "-")
-""")
+    misses = [kind for event, kind in cache_events if event == "miss" and kind.startswith("plan-")]
+    print(len(misses), digest, "scipy" if "scipy" in sys.modules else "-")
+"""
 
 
 def _racer(ready: Path, hold_s: float, n_racers: int) -> subprocess.Popen[str]:
-    ready.mkdir(exist_ok=True)
-    return subprocess.Popen([sys.executable, "-c", _RACER, str(ready), str(hold_s), str(n_racers)], cwd=REPO,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return start_racer(_RACE_BODY, ready, hold_s, n_racers)
 
 
 def test_two_processes_racing_on_an_empty_cache(private_cache: Path, tmp_path: Path) -> None:

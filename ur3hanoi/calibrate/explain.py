@@ -19,7 +19,7 @@ Joints are numbered 1..6 for people (``JOINT_LABELS``), angles shown in degrees 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -74,6 +74,43 @@ def _errors(robot: Ur3Model, T_wb: pin.SE3, q: FloatArray, target: pin.SE3) -> t
     return dp, dr
 
 
+def _best_single_joint(robot: Ur3Model, T_world_base: pin.SE3, q0: FloatArray, p_target: FloatArray,
+                       rot_world: FloatArray, scale_mm: float, scale_deg: float,
+                       errors: Callable[[FloatArray], tuple[float, float]]) -> tuple[int, float, float, float] | None:
+    """The single-joint change (joint, delta [rad], error [mm], error [deg]) of ``q0`` with the least weighed
+    ``errors``; None when no change of at least :data:`MIN_TYPO_DEG` is a candidate.
+
+    Per joint, three candidates: the turn that best undoes the world rotation ``rot_world`` (its component along the
+    joint's axis), the turn that carries the TCP round the axis towards ``p_target`` [m, world], and their blend
+    weighed by the lever arm, because a typo moves both position and orientation and either may dominate."""
+    T = T_world_base * robot.fk(q0, "tcp")
+    R = T.rotation
+    J = robot.frame_jacobian_local(q0, "tcp")
+    best: tuple[float, int, float, float, float] | None = None
+    for j in range(len(q0)):
+        u = R @ J[3:, j]
+        v = R @ J[:3, j]
+        lever = np.cross(v, u)  # TCP minus its foot on joint j's axis, perpendicular to the axis
+        radius = float(np.linalg.norm(lever))
+        d = p_target - (T.translation - lever)
+        d_perp = d - u * float(u @ d)
+        candidates = [float(u @ rot_world)]
+        if radius > 1e-6 and float(np.linalg.norm(d_perp)) > 1e-9:
+            d_pos = math.atan2(float(u @ np.cross(lever, d_perp)), float(lever @ d_perp))
+            a_p, a_r = (radius * 1e3 / scale_mm) ** 2, (180.0 / math.pi / scale_deg) ** 2
+            candidates += [d_pos, (a_p * d_pos + a_r * candidates[0]) / (a_p + a_r)]
+        for delta in candidates:
+            if abs(math.degrees(delta)) < MIN_TYPO_DEG:
+                continue
+            qj = q0.copy()
+            qj[j] += delta
+            dp, dr = errors(qj)
+            cost = (dp / scale_mm) ** 2 + (dr / scale_deg) ** 2
+            if best is None or cost < best[0]:
+                best = (cost, j, float(delta), dp, dr)
+    return None if best is None else best[1:]
+
+
 def joint_typo(robot: Ur3Model, T_world_base: pin.SE3, q: Sequence[float], p_target: FloatArray, yaw: float,
                tol_mm: float, tol_deg: float) -> JointTypo | None:
     """The single-joint change of ``q`` [rad] that best moves the TCP to ``p_target`` [m, world], pointing down at
@@ -82,33 +119,12 @@ def joint_typo(robot: Ur3Model, T_world_base: pin.SE3, q: Sequence[float], p_tar
     target = pin.SE3(R_world_tcp_down(yaw), np.asarray(p_target, dtype=float))
     T = T_world_base * robot.fk(q0, "tcp")
     R = T.rotation
-    J = robot.frame_jacobian_local(q0, "tcp")
     rot_err = pin.log3(target.rotation @ R.T)  # world-frame rotation that would align the tool
-    best: tuple[float, int, float, float, float] | None = None
-    for j in range(len(q0)):
-        u = R @ J[3:, j]
-        v = R @ J[:3, j]
-        lever = np.cross(v, u)  # TCP minus its foot on joint j's axis, perpendicular to the axis
-        radius = float(np.linalg.norm(lever))
-        w = target.translation - (T.translation - lever)
-        w_perp = w - u * float(u @ w)
-        candidates = [float(u @ rot_err)]
-        if radius > 1e-6 and float(np.linalg.norm(w_perp)) > 1e-9:
-            d_pos = math.atan2(float(u @ np.cross(lever, w_perp)), float(lever @ w_perp))
-            a_p, a_r = (radius * 1e3 / tol_mm) ** 2, (180.0 / math.pi / tol_deg) ** 2
-            candidates += [d_pos, (a_p * d_pos + a_r * candidates[0]) / (a_p + a_r)]
-        for delta in candidates:
-            if abs(math.degrees(delta)) < MIN_TYPO_DEG:
-                continue
-            qj = q0.copy()
-            qj[j] += delta
-            dp, dr = _errors(robot, T_world_base, qj, target)
-            cost = (dp / tol_mm) ** 2 + (dr / tol_deg) ** 2
-            if best is None or cost < best[0]:
-                best = (cost, j, float(delta), dp, dr)
+    best = _best_single_joint(robot, T_world_base, q0, target.translation, rot_err, tol_mm, tol_deg,
+                              lambda qj: _errors(robot, T_world_base, qj, target))
     if best is None:
         return None
-    _, j, delta, dp, dr = best
+    j, delta, dp, dr = best
     return JointTypo(joint=j, recorded=float(q0[j]), predicted=float(q0[j] + delta), residual_mm=dp, residual_deg=dr,
                      explains=dp <= tol_mm and dr <= tol_deg)
 
@@ -236,36 +252,15 @@ def joint_typo_point(robot: Ur3Model, T_world_base: pin.SE3, q: Sequence[float],
     p_target = np.asarray(p_target, dtype=float)
     T = T_world_base * robot.fk(q0, "tcp")
     R = T.rotation
-    J = robot.frame_jacobian_local(q0, "tcp")
     z = R[:, 2]
     w = np.cross(z, axis)
     s = float(np.linalg.norm(w))
     turn = w / s * math.atan2(s, float(z @ axis)) if s > 1e-12 else np.zeros(3)  # world rotation: z onto axis
-    best: tuple[float, int, float, float, float] | None = None
-    for j in range(len(q0)):
-        u = R @ J[3:, j]
-        v = R @ J[:3, j]
-        lever = np.cross(v, u)
-        radius = float(np.linalg.norm(lever))
-        d = p_target - (T.translation - lever)
-        d_perp = d - u * float(u @ d)
-        candidates = [float(u @ turn)]
-        if radius > 1e-6 and float(np.linalg.norm(d_perp)) > 1e-9:
-            d_pos = math.atan2(float(u @ np.cross(lever, d_perp)), float(lever @ d_perp))
-            a_p, a_r = (radius * 1e3 / scale_mm) ** 2, (180.0 / math.pi / scale_deg) ** 2
-            candidates += [d_pos, (a_p * d_pos + a_r * candidates[0]) / (a_p + a_r)]
-        for delta in candidates:
-            if abs(math.degrees(delta)) < MIN_TYPO_DEG:
-                continue
-            qj = q0.copy()
-            qj[j] += delta
-            dp, dt = _tilt_after(robot, T_world_base, qj, p_target, axis)
-            cost = (dp / scale_mm) ** 2 + (dt / scale_deg) ** 2
-            if best is None or cost < best[0]:
-                best = (cost, j, float(delta), dp, dt)
+    best = _best_single_joint(robot, T_world_base, q0, p_target, turn, scale_mm, scale_deg,
+                              lambda qj: _tilt_after(robot, T_world_base, qj, p_target, axis))
     if best is None:
         return None
-    _, j, delta, dp, dt = best
+    j, delta, dp, dt = best
     return JointTypo(joint=j, recorded=float(q0[j]), predicted=float(q0[j] + delta), residual_mm=dp, residual_deg=dt,
                      explains=False)
 
