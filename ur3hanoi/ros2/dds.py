@@ -9,6 +9,14 @@
 - **Type hashes**: each endpoint's USER_DATA carries ``typehash=RIHS01_<hex>;`` (Iron and later read it).
 - **Graph**: the node announces its readers and writers on ``ros_discovery_info`` (reliable, transient local,
   keep last 1, 16-byte Gids as on Jazzy and later), so ``ros2 node list`` / rclpy's graph show the node's name.
+  Jazzy (rmw_fastrtps 8.4, Fast DDS 2.14) also names each endpoint after it. Kilted (rmw_fastrtps 9.3, Fast DDS
+  3.2) lists the node but shows its endpoints as ``_CREATED_BY_BARE_DDS_APP_``: rmw_fastrtps files a discovered
+  endpoint under ``participant_guid`` (custom_participant_info.hpp:256), which Fast DDS 3 reads only from
+  PID_PARTICIPANT_GUID; Cyclone's SEDP never sends it (the participant is its GUID prefix) and Fast DDS's
+  fallback for that case fills only the older ``m_rtps_participant_key`` (Jazzy's source), so every Cyclone
+  endpoint lands under the all-zero participant gid (tests/test_ros2_rclpy_interop.py measures it). A second
+  entry announced under gid zero names them on Kilted, but then Jazzy and Kilted peers both list the node twice
+  and keep a ghost of it after a crash (no participant with gid zero ever leaves): measured, not done.
 - Fast DDS 3 (Kilted) announces XTypes information that Cyclone rejects for sequence types unless told to ignore
   eProsima's (vendor 1.15): the config does.
 """

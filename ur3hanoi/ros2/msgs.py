@@ -84,8 +84,8 @@ class Gid(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):  # type: ignor
 @dataclass
 @final
 class NodeEntitiesInfo(IdlStruct, typename="rmw_dds_common::msg::dds_::NodeEntitiesInfo_"):  # type: ignore[call-arg]
-    """A node's name and its endpoints. The names are ``string<256>`` as in rmw_dds_common's IDL: Fast DDS 3
-    (Kilted) compares XTypes type objects, where an unbounded string is another type (no match, no node name)."""
+    """A node's name and its endpoints; the names are ``string<256>`` as in rmw_dds_common's IDL (identical for
+    Jazzy's rmw_dds_common 3.1 and Kilted's 4.0)."""
 
     node_namespace: bounded_str[256] = "/"
     node_name: bounded_str[256] = ""
