@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from tests.ros2_support import in_netns, requires_netns
-from ur3hanoi.ros.movej import plan_movej
+from ur3hanoi.remote.movej import plan_movej
 from ur3hanoi.ros2.dds import cyclone_config
 from ur3hanoi.ros2.station import BRIDGE_MOVE_S, Ros2Station, Ros2StationOptions, bridge_speed
 from ur3hanoi.station import load_station

@@ -170,7 +170,7 @@ def _run_solve(args: argparse.Namespace) -> int:
     from ur3hanoi.labfile import read_recorded_table
     from ur3hanoi.robot import Q_HOME_LAB
     from ur3hanoi.ros.client import ArmConfig, RosArm
-    from ur3hanoi.ros.solve import LabSolveConfig, run_lab_solve
+    from ur3hanoi.remote.solve import LabSolveConfig, run_lab_solve
     from ur3hanoi.station import load_station
     from ur3hanoi.waypoints import generate_table
 

@@ -142,8 +142,8 @@ def _run_solve(args: argparse.Namespace) -> int:
     from ur3hanoi.errors import SuctionFaultError
     from ur3hanoi.hanoi import validate_instance
     from ur3hanoi.labfile import read_recorded_table
-    from ur3hanoi.ros.errors import RosError
-    from ur3hanoi.ros.solve import LabSolveConfig, run_lab_solve
+    from ur3hanoi.remote.errors import RosError
+    from ur3hanoi.remote.solve import LabSolveConfig, run_lab_solve
     from ur3hanoi.ros2.client import Ros2Arm, Ros2ArmConfig
     from ur3hanoi.ros2.dds import domain_id_from_env
     from ur3hanoi.station import load_station
