@@ -12,8 +12,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ur3hanoi.robot import N_JOINTS, JointLimits
 from ur3hanoi.remote.errors import CommandError
+from ur3hanoi.robot import N_JOINTS, JointLimits
 
 
 @dataclass(frozen=True)

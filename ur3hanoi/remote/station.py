@@ -38,7 +38,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import Any, ClassVar
 
 from ur3hanoi.remote.errors import CommandError, RosError
 
@@ -124,8 +124,8 @@ class StationCore:
         report_out: where the JSON report goes without ``options.report``.
     """
 
-    TOPIC_LOG: dict[str, str] = {"command": "command rejected, the arm does not move", "spawn": "spawn",
-                                 "remove": "remove_block"}
+    TOPIC_LOG: ClassVar[dict[str, str]] = {"command": "command rejected, the arm does not move",
+                                           "spawn": "spawn", "remove": "remove_block"}
     """Prefix of the log lines about each kind of message."""
 
     def __init__(self, options: CoreOptions, out: Callable[[str], None],

@@ -22,10 +22,10 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.hanoi import block_colour
-from ur3hanoi.robot import JOINT_NAMES
 from ur3hanoi.remote.command import MoveCommand
 from ur3hanoi.remote.errors import RosError
 from ur3hanoi.remote.movej import MoveJ, plan_movej
+from ur3hanoi.robot import JOINT_NAMES
 from ur3hanoi.sim import (
     FinalBlock,
     GripperInput,

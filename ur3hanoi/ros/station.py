@@ -15,7 +15,8 @@ The node speaks the course's topics and messages exactly (:mod:`ur3hanoi.ros.msg
 
 Real time, the bounded inbox, rate-limited logging and the report are the transport-neutral station's
 (:mod:`ur3hanoi.remote.station`); this module binds them to rospy. A roscore is started when none answers at
-``ROS_MASTER_URI`` (:mod:`ur3hanoi.ros.master`) and stopped on exit, or when the station dies (:mod:`ur3hanoi.ros.guard`).
+``ROS_MASTER_URI`` (:mod:`ur3hanoi.ros.master`) and stopped on exit, or when the station dies
+(:mod:`ur3hanoi.ros.guard`).
 
 A flood cannot stall the loop: the ROS callbacks only append to the bounded inbox
 (:data:`~ur3hanoi.remote.station.INBOX_MAX` messages), log lines are rate-limited and the records bounded
@@ -47,7 +48,7 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from ur3hanoi.remote.errors import RosError
 from ur3hanoi.remote.station import CoreOptions, StationCore
@@ -84,8 +85,8 @@ class RosStation(StationCore):
 
     options: StationOptions
 
-    TOPIC_LOG = {"command": "ur3/command rejected, the arm does not move", "spawn": "ur3hanoi/spawn",
-                 "remove": "ur3hanoi/remove_block"}
+    TOPIC_LOG: ClassVar[dict[str, str]] = {"command": "ur3/command rejected, the arm does not move",
+                                           "spawn": "ur3hanoi/spawn", "remove": "ur3hanoi/remove_block"}
 
     def __init__(self, options: StationOptions, out: Callable[[str], None] | None = None,
                  report_out: Callable[[str], None] | None = None) -> None:

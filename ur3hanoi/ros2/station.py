@@ -32,7 +32,7 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from types import SimpleNamespace
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -96,8 +96,8 @@ class Ros2Station(StationCore):
 
     options: Ros2StationOptions
 
-    TOPIC_LOG = {"command": f"{TOPIC_COMMAND} dropped, the arm does not move", "spawn": "spawn",
-                 "remove": "remove_block"}
+    TOPIC_LOG: ClassVar[dict[str, str]] = {"command": f"{TOPIC_COMMAND} dropped, the arm does not move",
+                                           "spawn": "spawn", "remove": "remove_block"}
 
     def __init__(self, options: Ros2StationOptions, out: Callable[[str], None] | None = None,
                  log: Callable[[str], None] | None = None) -> None:
