@@ -175,7 +175,7 @@ def test_absurd_commands_are_refused_with_a_log_line_and_the_next_command_runs()
 
 def test_bridge_timing_ignores_v_and_a_but_refuses_bad_destinations_for_themselves() -> None:
     """The bridge ignores v and a: v = a = 5e-324 is a 2 s move; a NaN destination is refused naming the angle
-    (not the speed derived from it); out-of-limit angles are refused."""
+    (not the NaN speed the 2 s timing derives from it); out-of-limit angles are refused."""
     logged: list[str] = []
     st = Ros2Station(Ros2StationOptions(), out=lambda s: None, log=logged.append)
     home = np.array(st.position())

@@ -131,8 +131,7 @@ class Ros2Station(StationCore):
         if self.options.timing == "bridge":
             queue = self.driver.queue
             start = np.array(queue[-1].destination) if queue else self.world.target
-            # The bridge ignores v and a; a non-finite destination is refused for itself, not for its speed.
-            v, a = bridge_speed(start, q) if np.all(np.isfinite(q)) else (1.0, 1.0)
+            v, a = bridge_speed(start, q)  # the bridge ignores v and a (a bad destination is named first)
         self.driver.submit(q.tolist(), v, a, msg.io_0)
 
     def handle(self, destination: Any, v: float, a: float, io_0: bool) -> bool:
