@@ -39,15 +39,17 @@ from ur3hanoi.cli.solve import prompt_tower
 
 
 def station_parser(sub: argparse._SubParsersAction, name: str, summary: str, description: str,
-                   default_calibration: str, analog: str) -> argparse.ArgumentParser:
+                   default_calibration: str, analog: str, rate_note: str = "") -> argparse.ArgumentParser:
     """The ``name`` station subcommand with ``--calibration`` .. ``--rate`` (:func:`add_station_options`)."""
     p: argparse.ArgumentParser = sub.add_parser(name, help=summary, description=description)
-    add_station_options(p, default_calibration, analog)
+    add_station_options(p, default_calibration, analog, rate_note)
     return p
 
 
-def add_station_options(p: argparse.ArgumentParser, default_calibration: str, analog: str) -> None:
-    """``--calibration`` .. ``--rate``: the station, its blocks, fault injection, noise seed (of ``analog``)."""
+def add_station_options(p: argparse.ArgumentParser, default_calibration: str, analog: str, rate_note: str = ""
+                        ) -> None:
+    """``--calibration`` .. ``--rate``: the station, its blocks, fault injection, noise seed (of ``analog``);
+    ``rate_note`` follows the rate's default in the help."""
     p.add_argument("--calibration", default=None, metavar="CAL",
                    help=f"station calibration YAML or shipped name (default {default_calibration})")
     p.add_argument("--start", type=station_number("a tower"), default=1, metavar="T",
@@ -60,7 +62,7 @@ def add_station_options(p: argparse.ArgumentParser, default_calibration: str, an
                    help="fault injection: the block of the K-th grasp falls off during the next motion")
     p.add_argument("--seed", type=option(SEED), default=0, metavar="K", help=f"seed of the {analog} noise")
     p.add_argument("--rate", type=option(ROS_RATE), default=125.0, metavar="HZ",
-                   help="control and publishing rate, 50..500 Hz, period a multiple of 2 ms (default 125, CB3)")
+                   help=f"control and publishing rate, 50..500 Hz, period a multiple of 2 ms (default 125{rate_note})")
 
 
 def add_station_outputs(p: argparse.ArgumentParser) -> None:

@@ -53,7 +53,7 @@ def add(sub: argparse._SubParsersAction) -> None:
 
 def _add_station(sub: argparse._SubParsersAction) -> None:
     p = remote.station_parser(
-        sub, "ros-station", _STATION_HELP, _STATION_DESCRIPTION, DEFAULT_CALIBRATION, "AIN0")
+        sub, "ros-station", _STATION_HELP, _STATION_DESCRIPTION, DEFAULT_CALIBRATION, "AIN0", ", CB3")
     p.add_argument("--master", metavar="URI", help=_master_help())
     p.add_argument("--host", metavar="ADDR", default="127.0.0.1",
                    help="address the station and the roscore it starts listen on and advertise (ROS_IP); default "
