@@ -6,13 +6,16 @@ from __future__ import annotations
 
 import json
 import math
+import subprocess
+import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from tests.ros2_support import in_netns, requires_netns
-from ur3hanoi.ros.movej import plan_movej
+from ur3hanoi.remote.movej import plan_movej
 from ur3hanoi.ros2.dds import cyclone_config
 from ur3hanoi.ros2.station import BRIDGE_MOVE_S, Ros2Station, Ros2StationOptions, bridge_speed
 from ur3hanoi.station import load_station
@@ -106,3 +109,174 @@ exit $CODE
     assert durations and all(abs(d - BRIDGE_MOVE_S) < 1e-9 for d in durations)
     assert r["final"]["at_home"] and not r["final"]["suction_on"]
     assert [e["kind"] for e in r["suction_events"]].count("grasp") == 0
+
+
+# ------------------------------------------------------------------------------------------------- hardening
+
+COURSE_OFFSET = np.array([math.pi / 2, 0, 0, -math.pi / 2, 0, 0])
+
+
+def _run_until_idle(st: Ros2Station, max_cycles: int) -> None:
+    for _ in range(max_cycles):
+        st.cycle()
+        if not st.driver.queue and st.driver.ready:
+            return
+    raise AssertionError(f"the station did not come to rest within {max_cycles} cycles")
+
+
+def _absurd(home_course: np.ndarray) -> tuple[list[float], list[dict[str, object]]]:
+    near = (home_course + np.array([0.2, 0, 0, 0, 0, 0])).tolist()
+    far = (home_course + np.array([1.5, 0, 0, 0, 0, 0])).tolist()
+    return near, [
+        {"destination": near[:5], "v": 1.0, "a": 1.0, "io_0": True},
+        {"destination": [near[0], math.nan, *near[2:]], "v": 1.0, "a": 1.0, "io_0": True},
+        {"destination": near, "v": 1e-9, "a": 1e-9, "io_0": True},  # a 2e8 s move
+        {"destination": near, "v": 5e-324, "a": 5e-324, "io_0": True},  # the smallest double: an infinite move
+        {"destination": far, "v": 0.02, "a": 0.02, "io_0": True},  # 76 s: longer than MAX_MOVE_S
+    ]
+
+
+HONEST_REFUSALS = [
+    "destination has 5 values: expected 6 joint angles [rad]",
+    "destination[1] = nan is invalid: expected a finite angle [rad]",
+    "the move would take ",
+    "the move would take ",
+    "the move would take ",
+]
+
+
+def test_absurd_commands_are_refused_with_a_log_line_and_the_next_command_runs() -> None:
+    """Honest timing: wrong length, NaN, v = a = 1e-9 and 5e-324, a 76 s move: each refused with its reason, no
+    motion, one log line at once and one summary naming the others; then a valid command runs."""
+    from ur3hanoi.remote.driver import MAX_MOVE_S
+
+    logged: list[str] = []
+    st = Ros2Station(Ros2StationOptions(timing="honest"), out=lambda s: None, log=logged.append)
+    home = np.array(st.position())
+    near, bad = _absurd(home)
+    for fields in bad:
+        st.on_command(SimpleNamespace(**fields))
+    st.cycle()
+    report = st.report()
+    reasons = [r["reason"] for r in report["rejected"]]
+    assert len(reasons) == 5 and all(r.startswith(p) for r, p in zip(reasons, HONEST_REFUSALS, strict=True)), reasons
+    assert all(f"expected at most {MAX_MOVE_S:g} s (raise v or a)" in r for r in reasons[2:]), reasons
+    assert report["executed"] == [] and report["commands"]["queued"] == 0
+    st.log.flush(force=True)
+    prefix = "[ERROR] ur3e/command dropped, the arm does not move: "
+    assert logged[0] == prefix + reasons[0] and len(logged) == 2, logged
+    assert all(f"1 x {r}" in logged[1] for r in reasons[1:]), logged
+    assert np.max(np.abs(np.array(st.position()) - home)) < 1e-6  # no motion
+    st.on_command(SimpleNamespace(destination=near, v=4.0, a=4.0, io_0=False))
+    _run_until_idle(st, 1000)
+    assert st.driver.n_executed == 1
+    assert np.max(np.abs(np.array(st.position()) - np.array(near))) < 5e-4
+
+
+def test_bridge_timing_ignores_v_and_a_but_refuses_bad_destinations_for_themselves() -> None:
+    """The bridge ignores v and a: v = a = 5e-324 is a 2 s move; a NaN destination is refused naming the angle
+    (not the NaN speed the 2 s timing derives from it); out-of-limit angles are refused."""
+    logged: list[str] = []
+    st = Ros2Station(Ros2StationOptions(), out=lambda s: None, log=logged.append)
+    home = np.array(st.position())
+    near, _ = _absurd(home)
+    assert not st.handle([near[0], math.nan, *near[2:]], 1.0, 1.0, False)
+    assert not st.handle([near[0], math.inf, *near[2:]], 1.0, 1.0, False)
+    assert not st.handle([7.0, *near[1:]], 1.0, 1.0, False)
+    reasons = [r.reason for r in st.driver.rejected]
+    assert reasons[:2] == ["destination[1] = nan is invalid: expected a finite angle [rad]",
+                           "destination[1] = inf is invalid: expected a finite angle [rad]"]
+    assert reasons[2].startswith("destination[0] = ") and "outside joint 1's limits" in reasons[2]
+    assert st.handle(near, 5e-324, 5e-324, False)
+    _run_until_idle(st, 1000)
+    assert [m.duration_s for m in st.driver.executed] == [pytest.approx(BRIDGE_MOVE_S, abs=1e-9)]
+    assert np.max(np.abs(np.array(st.position()) - np.array(near))) < 5e-4
+    assert len(logged) == 1  # the first refusal at once; the others wait for the next second's summary
+
+
+PUBLISHER = f"{sys.executable} {REPO / 'tests' / 'ros2_publisher.py'}"
+
+
+def _left_running(marker: Path) -> list[str]:
+    """Processes whose command line names ``marker`` (a test's own report path): none may outlive the test."""
+    r = subprocess.run(["pgrep", "-af", str(marker)], capture_output=True, text=True, check=False)
+    return r.stdout.strip().splitlines()
+
+
+def _log_lines(text: str) -> list[str]:
+    return [line for line in text.splitlines() if line.startswith(("[INFO]", "[WARN]", "[ERROR]"))]
+
+
+@pytest.mark.dds
+@requires_netns
+def test_absurd_commands_over_dds_are_refused_and_sigterm_stops_the_station_cleanly(tmp_path: Path) -> None:
+    """Honest timing, over DDS: wrong length, NaN, v = a = 1e-9 and 5e-324, a move longer than MAX_MOVE_S are
+    refused with log lines and no motion; the next command runs; SIGUSR1 writes a report without stopping;
+    SIGTERM stops the station with exit 0 and its final report; nothing it started is left."""
+    report = tmp_path / "report.json"
+    home = np.array(Ros2Station(Ros2StationOptions(), out=lambda s: None).position())
+    near, bad = _absurd(home)
+    good = [{"destination": near, "v": 4.0, "a": 4.0, "io_0": False}]
+    script = f"""
+$UR3HANOI ros2-station --timing honest --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
+ST=$!
+wait_ready {tmp_path}/st.out || exit 90
+{PUBLISHER} '{json.dumps(bad)}' || exit 91
+kill -USR1 $ST; sleep 0.5; cp {report} {tmp_path}/snap.json
+{PUBLISHER} '{json.dumps(good)}' || exit 92
+sleep 1.5
+kill -TERM $ST; wait $ST; echo "station exit $?" >&2
+"""
+    result = in_netns(script, 120.0, REPO)
+    err = (tmp_path / "st.err").read_text()
+    assert result.returncode == 0, result.stdout + result.stderr + err
+    assert "station exit 0" in result.stderr
+    snap, r = json.loads((tmp_path / "snap.json").read_text()), json.loads(report.read_text())
+    reasons = [x["reason"] for x in r["rejected"]]
+    assert len(reasons) == 5 and all(x.startswith(p) for x, p in zip(reasons, HONEST_REFUSALS, strict=True)), reasons
+    assert snap["executed"] == [] and snap["commands"]["rejected"] == 5
+    assert max(abs(a - b) for a, b in zip(snap["final"]["q"], load_station("ur3e_sim").q_home, strict=True)) < 1e-6
+    assert r["commands"]["executed"] == 1 and r["reports_written"] == snap["reports_written"] + 1
+    assert max(abs(a - b - o) for a, b, o in zip(r["final"]["q"], near, COURSE_OFFSET, strict=True)) < 5e-4
+    lines = _log_lines(err)
+    assert lines[0] == f"[ERROR] ur3e/command dropped, the arm does not move: {reasons[0]}"
+    assert len(lines) <= 3 and all(any(f"1 x {x}" in line for line in lines) for x in reasons[1:]), lines
+    assert _left_running(report) == []
+
+
+@pytest.mark.dds
+@requires_netns
+def test_a_1_khz_command_flood_over_dds_stays_bounded_and_sigint_stops_the_station(tmp_path: Path) -> None:
+    """1 kHz of commands for 4 s (bridge timing: the queue fills, most are refused): ur3e/position keeps coming,
+    log lines stay about one per second, the report small; SIGINT stops the station cleanly."""
+    report = tmp_path / "report.json"
+    home = Ros2Station(Ros2StationOptions(), out=lambda s: None).position()
+    near = [home[0] + 0.05, *home[1:]]
+    fields = [{"destination": near, "v": 4.0, "a": 4.0, "io_0": False},
+              {"destination": home, "v": 4.0, "a": 4.0, "io_0": True}]
+    seconds = 4.0
+    script = f"""
+$UR3HANOI ros2-station --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
+ST=$!
+wait_ready {tmp_path}/st.out || exit 90
+{PUBLISHER} --flood 1000 {seconds} '{json.dumps(fields)}' || exit 91
+kill -INT $ST; wait $ST; echo "station exit $?" >&2
+"""
+    result = in_netns(script, 120.0, REPO)
+    err = (tmp_path / "st.err").read_text()
+    assert result.returncode == 0, result.stdout + result.stderr + err
+    assert "station exit 0" in result.stderr
+    flood = json.loads(result.stdout.strip().splitlines()[-1])
+    assert flood["sent"] >= 0.9 * 1000 * seconds
+    assert flood["positions"] >= 0.5 * 125 * seconds
+    assert flood["max_gap_s"] < 0.25, flood  # 2 periods is the target; this bounds a stall on any shared CPU
+    lines = _log_lines(err)
+    assert 1 <= len(lines) <= seconds + 3, lines[:5]
+    r = json.loads(report.read_text())
+    c = r["commands"]
+    assert c["executed"] + c["rejected"] + c["queued"] == r["transport"]["received"] <= flood["sent"]
+    assert r["transport"]["received"] >= 0.5 * flood["sent"]  # DDS keep-last 10 may drop some at this rate
+    assert c["executed"] > 0 and c["rejected"] > 0
+    assert len(r["executed"]) <= 100 and len(r["rejected"]) <= 100
+    assert report.stat().st_size < 100_000
+    assert _left_running(report) == []

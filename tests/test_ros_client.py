@@ -7,8 +7,8 @@ import sys
 import pytest
 
 from tests.ros_support import free_port, requires_ros, ros_env, roscore, run
+from ur3hanoi.remote.errors import RosError
 from ur3hanoi.ros.client import RosArm
-from ur3hanoi.ros.errors import RosError
 
 
 def test_connect_without_a_master_fails_at_once():

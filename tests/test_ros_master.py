@@ -11,7 +11,7 @@ import time
 import pytest
 
 from tests.ros_support import alive, free_port, requires_ros, ros_env
-from ur3hanoi.ros.errors import RosError
+from ur3hanoi.remote.errors import RosError
 from ur3hanoi.ros.guard import LOG_DIR_PREFIX, remove_stale_log_dirs
 from ur3hanoi.ros.master import MasterUri, RosCore, listen_env, master_answers, master_pid, probe_master
 

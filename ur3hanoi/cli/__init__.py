@@ -2,7 +2,9 @@
 
 One module per command (``add`` builds its parser, ``run`` executes it); :mod:`~ur3hanoi.cli.options` holds every
 numeric option's range, :mod:`~ur3hanoi.cli.exit_codes` the exit codes and which error maps to which, and
-:mod:`~ur3hanoi.cli.main` the entry point that turns every error into one line on stderr.
+:mod:`~ur3hanoi.cli.main` the entry point that turns every error into one line on stderr. The ROS 1 and ROS 2
+commands (:mod:`~ur3hanoi.cli.ros`, :mod:`~ur3hanoi.cli.ros2`) share their options, solve and outcome handling
+through :mod:`~ur3hanoi.cli.remote`.
 """
 
 import os

@@ -35,8 +35,8 @@ from types import TracebackType
 from typing import Any
 from urllib.parse import urlsplit
 
+from ur3hanoi.remote.errors import RosError
 from ur3hanoi.ros.env import roscore_executable
-from ur3hanoi.ros.errors import RosError
 
 DEFAULT_MASTER_URI = "http://localhost:11311"
 

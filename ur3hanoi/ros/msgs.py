@@ -19,8 +19,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from ur3hanoi.remote.errors import RosError
 from ur3hanoi.ros.env import SITECUSTOMIZE, ensure_ros_python
-from ur3hanoi.ros.errors import RosError
 
 PACKAGE = "ur3_driver"
 

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.ros.errors import RosError
+from ur3hanoi.remote.errors import RosError
 
 
 def _worker(conn: Connection, calibration: str, n_blocks: int, frames: Path | None, video: Path | None) -> None:

@@ -4,8 +4,9 @@
 - :mod:`~ur3hanoi.ros2.dds`: a ROS 2 node made of one Cyclone DDS participant (loopback-only by default, ROS 2's
   default QoS, type hashes in USER_DATA, the node announced on ``ros_discovery_info``).
 - :mod:`~ur3hanoi.ros2.station`: ``ros2-station``, the MuJoCo station as the course bridge.
-- :mod:`~ur3hanoi.ros2.client`: ``ros2-solve``'s arm, driven by :func:`ur3hanoi.ros.solve.run_lab_solve`.
+- :mod:`~ur3hanoi.ros2.client`: ``ros2-solve``'s arm, driven by :func:`ur3hanoi.remote.solve.run_lab_solve`.
 
-The world, command checks, motion and suction logic are the ROS 1 station's (middleware-free modules of
-:mod:`ur3hanoi.ros`); only the transport differs.
+The world, command checks, motion, suction, the station's loop and report and the client's move-and-wait are the
+middleware-free :mod:`ur3hanoi.remote`, shared with the ROS 1 binding :mod:`ur3hanoi.ros`; only the transport
+differs.
 """

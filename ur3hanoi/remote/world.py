@@ -2,7 +2,7 @@
 
 :class:`StationWorld` owns the scene (:func:`ur3hanoi.sim.build_task_scene`), the suction cup
 (:class:`ur3hanoi.sim.SuctionCup`: grasp by weld, ``gripper_input`` feedback) and the blocks. Each :meth:`step`
-advances one control period: the reference of the running ``movej`` (:mod:`ur3hanoi.ros.movej`) is sent to the
+advances one control period: the reference of the running ``movej`` (:mod:`ur3hanoi.remote.movej`) is sent to the
 position servos with velocity feed-forward (as :func:`ur3hanoi.sim.run_plan` does), the physics runs, the suction
 grasps a block in reach. Nothing here knows ROS or the wall clock: the node (:mod:`ur3hanoi.ros.station`) calls
 :meth:`step` once per period in real time, tests call it as fast as they like.
@@ -22,10 +22,10 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.hanoi import block_colour
+from ur3hanoi.remote.command import MoveCommand
+from ur3hanoi.remote.errors import RosError
+from ur3hanoi.remote.movej import MoveJ, plan_movej
 from ur3hanoi.robot import JOINT_NAMES
-from ur3hanoi.ros.command import MoveCommand
-from ur3hanoi.ros.errors import RosError
-from ur3hanoi.ros.movej import MoveJ, plan_movej
 from ur3hanoi.sim import (
     FinalBlock,
     GripperInput,

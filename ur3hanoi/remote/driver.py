@@ -1,6 +1,6 @@
 """The station's controller logic: accept or refuse commands, execute them in order, measure how the arm settles.
 
-:class:`StationDriver` sits between the ROS callbacks and :class:`~ur3hanoi.ros.world.StationWorld`. Accepted
+:class:`StationDriver` sits between the ROS callbacks and :class:`~ur3hanoi.remote.world.StationWorld`. Accepted
 commands wait in a FIFO and each starts when the previous motion's profile has ended (a controller's motion
 queue); the lab's ``move_arm`` re-publishes its command every 5 s while waiting, which then costs a zero-length
 move, never a jump. Every executed command is recorded with its duration, the time the arm needed to come within
@@ -26,10 +26,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from ur3hanoi.ros.command import MoveCommand, parse_command
-from ur3hanoi.ros.errors import CommandError
-from ur3hanoi.ros.movej import plan_movej
-from ur3hanoi.ros.world import StationWorld
+from ur3hanoi.remote.command import MoveCommand, parse_command
+from ur3hanoi.remote.errors import CommandError
+from ur3hanoi.remote.movej import plan_movej
+from ur3hanoi.remote.world import StationWorld
 
 MAX_MOVE_S = 60.0
 """Longest ``movej`` [s] the station accepts (see the module docstring)."""

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from ur3hanoi.remote.movej import plan_movej
 from ur3hanoi.robot import JointLimits
-from ur3hanoi.ros.movej import plan_movej
 
 LIM = JointLimits.ur3()
 V_MAX, A_MAX = np.array(LIM.v_max), np.array(LIM.a_max)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import itertools
 import re
 
-from ur3hanoi.ros.lograte import RateLimitedLog
+from ur3hanoi.remote.lograte import RateLimitedLog
 
 
 class Clock:

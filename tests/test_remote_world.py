@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from ur3hanoi.ros.command import MoveCommand
-from ur3hanoi.ros.errors import RosError
-from ur3hanoi.ros.world import StationWorld, WorldConfig
+from ur3hanoi.remote.command import MoveCommand
+from ur3hanoi.remote.errors import RosError
+from ur3hanoi.remote.world import StationWorld, WorldConfig
 from ur3hanoi.waypoints import generate_table
 
 TOL = 5e-4  # [rad] the lab's move_arm tolerance

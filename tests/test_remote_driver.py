@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from ur3hanoi.ros.driver import StationDriver
-from ur3hanoi.ros.errors import CommandError
-from ur3hanoi.ros.world import StationWorld
+from ur3hanoi.remote.driver import StationDriver
+from ur3hanoi.remote.errors import CommandError
+from ur3hanoi.remote.world import StationWorld
 from ur3hanoi.waypoints import generate_table
 
 

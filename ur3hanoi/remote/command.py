@@ -3,7 +3,7 @@
 A real controller refuses a joint move it cannot execute; so does the station, with a logged error and no motion:
 a destination that is not exactly 6 finite joint angles inside the joint limits, or a speed/acceleration that is
 not a finite positive number. Valid speeds and accelerations above the UR3's limits are accepted and capped per
-joint (:mod:`ur3hanoi.ros.movej`), as the course drivers clamp them.
+joint (:mod:`ur3hanoi.remote.movej`), as the course drivers clamp them.
 """
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from ur3hanoi.remote.errors import CommandError
 from ur3hanoi.robot import N_JOINTS, JointLimits
-from ur3hanoi.ros.errors import CommandError
 
 
 @dataclass(frozen=True)

@@ -6,8 +6,8 @@ lower it **checking it stays held all the way**, suction off, back up; finally h
 block is held where one must be, it halts like the lab asks: suction off, arm home, then
 :class:`~ur3hanoi.errors.SuctionFaultError` (exit code 3) with a one-line message.
 
-The arm is any object with the :class:`Arm` methods: :class:`ur3hanoi.ros.client.RosArm` drives the course's ROS
-interface (``ros-station`` or the real UR3), tests use a fake.
+The arm is any object with the :class:`Arm` methods: :class:`ur3hanoi.remote.client.TopicArm`, bound to ROS 1
+(``ros-station`` or the real UR3) or ROS 2 (``ros2-station`` or the course's UR3e bridge); tests use a fake.
 """
 
 from __future__ import annotations

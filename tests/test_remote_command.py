@@ -7,9 +7,9 @@ import math
 import pytest
 
 from ur3hanoi.errors import Ur3HanoiError
+from ur3hanoi.remote.command import parse_command
+from ur3hanoi.remote.errors import CommandError
 from ur3hanoi.robot import Q_HOME_LAB, JointLimits
-from ur3hanoi.ros.command import parse_command
-from ur3hanoi.ros.errors import CommandError
 
 LIM = JointLimits.ur3(elbow_limit=math.pi)
 

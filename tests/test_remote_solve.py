@@ -1,4 +1,4 @@
-"""The lab program's solve (ur3hanoi.ros.solve): in world time against the simulated station (no ROS), and end
+"""The lab program's solve (ur3hanoi.remote.solve): in world time against the simulated station (no ROS), and end
 to end as ``ur3hanoi ros-solve`` against ``ur3hanoi ros-station`` over a real roscore (marked ``ros``)."""
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import pytest
 
 from tests.ros_support import final_slots, free_port, requires_ros, ros_env, roscore, run, station, ur3hanoi_cmd
 from ur3hanoi.errors import PuzzleError, SuctionFaultError
-from ur3hanoi.ros.driver import StationDriver
-from ur3hanoi.ros.solve import run_lab_solve
-from ur3hanoi.ros.world import StationWorld
+from ur3hanoi.remote.driver import StationDriver
+from ur3hanoi.remote.solve import run_lab_solve
+from ur3hanoi.remote.world import StationWorld
 from ur3hanoi.waypoints import generate_table
 
 

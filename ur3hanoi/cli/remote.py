@@ -1,0 +1,216 @@
+"""What the station and solve subcommands of both middlewares share (:mod:`ur3hanoi.cli.ros`,
+:mod:`ur3hanoi.cli.ros2`): their common options, the station options they build, the "stopped" line, and the
+solve's table, towers, outcome and exit handling around a connected arm (:mod:`ur3hanoi.remote`).
+
+Conventions as in the other subcommands: towers, heights, blocks and grasps numbered from 1; errors one line with
+exit code 2; a suction fault exits with 3 (after printing the ``--json`` outcome).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ur3hanoi.arrays import FloatArray
+from ur3hanoi.cli.common import add_suction_profile_option
+from ur3hanoi.cli.options import (
+    BLOCKS,
+    CMD_ACCELERATION,
+    CMD_SPEED,
+    DURATION,
+    GRASP_TIMEOUT,
+    HEIGHT,
+    MOVE,
+    ROS_RATE,
+    SEED,
+    UsageError,
+    check_number,
+    option,
+    station_number,
+)
+from ur3hanoi.cli.solve import prompt_tower
+
+# --------------------------------------------------------------------------------------------------- stations
+
+
+def station_parser(sub: argparse._SubParsersAction, name: str, summary: str, description: str,
+                   default_calibration: str, analog: str, rate_note: str = "") -> argparse.ArgumentParser:
+    """The ``name`` station subcommand with ``--calibration`` .. ``--rate`` (:func:`add_station_options`)."""
+    p: argparse.ArgumentParser = sub.add_parser(name, help=summary, description=description)
+    add_station_options(p, default_calibration, analog, rate_note)
+    return p
+
+
+def add_station_options(p: argparse.ArgumentParser, default_calibration: str, analog: str, rate_note: str = ""
+                        ) -> None:
+    """``--calibration`` .. ``--rate``: the station, its blocks, fault injection, noise seed (of ``analog``);
+    ``rate_note`` follows the rate's default in the help."""
+    p.add_argument("--calibration", default=None, metavar="CAL",
+                   help=f"station calibration YAML or shipped name (default {default_calibration})")
+    p.add_argument("--start", type=station_number("a tower"), default=1, metavar="T",
+                   help="tower the blocks are spawned on (default 1)")
+    p.add_argument("--blocks", type=option(BLOCKS), default=None, metavar="N",
+                   help="number of blocks (default: the grid's)")
+    p.add_argument("--remove-block", type=option(HEIGHT), metavar="H",
+                   help="fault injection: spawn without the block at height H, like lab2_spawn.py")
+    p.add_argument("--drop-on-grasp", type=option(MOVE), metavar="K",
+                   help="fault injection: the block of the K-th grasp falls off during the next motion")
+    p.add_argument("--seed", type=option(SEED), default=0, metavar="K", help=f"seed of the {analog} noise")
+    p.add_argument("--rate", type=option(ROS_RATE), default=125.0, metavar="HZ",
+                   help=f"control and publishing rate, 50..500 Hz, period a multiple of 2 ms (default 125{rate_note})")
+
+
+def add_station_outputs(p: argparse.ArgumentParser) -> None:
+    """``--report``, ``--duration``, ``--suction-profile``."""
+    p.add_argument("--report", metavar="FILE", help="write the JSON report to FILE (default: stdout)")
+    p.add_argument("--duration", type=option(DURATION), metavar="S", help="stop by itself after S seconds")
+    add_suction_profile_option(p)
+
+
+def station_options(args: argparse.Namespace, default_calibration: str, report: Path | None) -> dict[str, Any]:
+    """The :class:`ur3hanoi.remote.station.CoreOptions` fields of the common options (numbers from 0)."""
+    return {"calibration": args.calibration or default_calibration, "start": args.start - 1,
+            "n_blocks": args.blocks, "removed": None if args.remove_block is None else args.remove_block - 1,
+            "drop_on_grasp": None if args.drop_on_grasp is None else args.drop_on_grasp - 1, "seed": args.seed,
+            "rate_hz": args.rate, "report": report, "duration_s": args.duration,
+            "suction_profile": args.suction_profile}
+
+
+def stopped_line(command: str, report: dict[str, Any], extra: str = "") -> str:
+    """``COMMAND stopped: N commands executed, M refused; EXTRA`` (``extra`` ends with the report file)."""
+    c = report["commands"]
+    return f"{command} stopped: {c['executed']} commands executed, {c['rejected']} refused; {extra}"
+
+
+# ------------------------------------------------------------------------------------------------------ solve
+
+
+def solve_parser(sub: argparse._SubParsersAction, name: str, summary: str, description: str,
+                 calibration_help: str, speed_notes: tuple[str, str], default_speed: float) -> argparse.ArgumentParser:
+    """The ``name`` solve subcommand with :func:`add_solve_options` and ``--calibration``."""
+    p: argparse.ArgumentParser = sub.add_parser(name, help=summary, description=description)
+    add_solve_options(p, speed_notes, default_speed)
+    p.add_argument("--calibration", default=None, metavar="CAL", help=calibration_help)
+    return p
+
+
+def add_solve_options(p: argparse.ArgumentParser, speed_notes: tuple[str, str], default_speed: float) -> None:
+    """``--start`` .. ``--key``, ``--v``/``--a`` (``speed_notes`` follow their defaults in the help),
+    ``--grasp-timeout`` (``--calibration`` is the binding's)."""
+    p.add_argument("--start", type=station_number("a tower"), metavar="S", help="start tower (1-based)")
+    p.add_argument("--end", type=station_number("a tower"), metavar="E", help="destination tower (1-based)")
+    p.add_argument("--blocks", type=option(BLOCKS), default=None, metavar="N",
+                   help="number of blocks (default: the table's)")
+    p.add_argument("--table", metavar="FILE", help="lab-format table (lab2_data.yaml, controller convention); "
+                                                   "default: IK of --calibration")
+    p.add_argument("--key", default=None, choices=["sim_pos", "real_pos"], help="table key (default sim_pos)")
+    p.add_argument("--v", type=option(CMD_SPEED), default=default_speed, metavar="V",
+                   help=f"joint speed sent with each command [rad/s] (default {default_speed:.1f}{speed_notes[0]})")
+    p.add_argument("--a", type=option(CMD_ACCELERATION), default=default_speed, metavar="A",
+                   help=f"joint acceleration sent with each command [rad/s^2] (default {default_speed:.1f}"
+                        f"{speed_notes[1]})")
+    p.add_argument("--grasp-timeout", type=option(GRASP_TIMEOUT), default=1.0, metavar="S",
+                   help="wait at most S seconds for the vacuum switch after suction on (default 1)")
+
+
+def add_json_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--json", action="store_true", help="print one JSON object with the outcome on stdout")
+
+
+@dataclass(frozen=True)
+class SolveJob:
+    """What a solve subcommand runs: the table ``Q`` [rad, controller convention], the home pose [rad], towers
+    (0-based) and the number of blocks."""
+
+    Q: FloatArray
+    home: FloatArray
+    start: int
+    end: int
+    n_blocks: int
+
+
+def solve_job(args: argparse.Namespace, command: str, default_calibration: str, station_optional: bool) -> SolveJob:
+    """The table (``--table``/``--key`` or generated from ``--calibration``), home, towers (prompted on a terminal
+    when missing) and blocks, checked. With ``station_optional``, ``--table`` without ``--calibration`` uses no
+    station (the lab's home)."""
+    import numpy as np
+
+    from ur3hanoi.hanoi import validate_instance
+    from ur3hanoi.labfile import read_recorded_table
+    from ur3hanoi.robot import Q_HOME_LAB
+    from ur3hanoi.station import load_station
+    from ur3hanoi.waypoints import generate_table
+
+    if args.table is None and args.key is not None:
+        raise UsageError("--key is only used with --table (the table is generated from --calibration otherwise)")
+    station = None if station_optional and args.table is not None and args.calibration is None else \
+        load_station(args.calibration or default_calibration)
+    # The reader and the entry rule of `solve --table` (entries never visited may miss).
+    recorded = read_recorded_table(args.table, args.key or "sim_pos") if args.table is not None else None
+    if recorded is not None:
+        Q = recorded.q
+    else:
+        assert station is not None
+        Q = generate_table(station).q
+    home = np.array(Q_HOME_LAB if station is None else station.q_home, dtype=float)
+    n_towers, n_heights = Q.shape[0], Q.shape[1]
+    n_blocks = n_heights if args.blocks is None else args.blocks
+    why = f"{station.name} has {n_towers} towers" if station is not None else f"the table has {n_towers} towers"
+    check_number("--start", args.start, n_towers, "a tower", why)
+    check_number("--end", args.end, n_towers, "a tower", why)
+    if args.start is None or args.end is None:
+        if not sys.stdin.isatty():
+            raise UsageError("--start and --end are required when stdin is not a terminal "
+                             f"(towers 1..{n_towers}), e.g. ur3hanoi {command} --start 1 --end 3")
+        start = args.start - 1 if args.start is not None else prompt_tower("start", n_towers)
+        end = args.end - 1 if args.end is not None else prompt_tower("end", n_towers, exclude=start)
+    else:
+        start, end = args.start - 1, args.end - 1
+    validate_instance(n_blocks, start, end, n_towers, n_heights)
+    if recorded is not None:
+        Q = recorded.for_solve(start, end, n_blocks)
+    return SolveJob(Q, home, start, end, n_blocks)
+
+
+def say_for(args: argparse.Namespace) -> Callable[[str], None]:
+    """Where progress lines go: stdout, or stderr with ``--json`` (stdout carries only the outcome)."""
+    if args.json:
+        return lambda s: print(s, file=sys.stderr, flush=True)
+    return lambda s: print(s, flush=True)
+
+
+def drive(args: argparse.Namespace, arm: Any, job: SolveJob, connected: str,
+          outcome: dict[str, object]) -> int:
+    """Connect ``arm`` (a :class:`ur3hanoi.remote.client.TopicArm`), say ``connected``, run the lab's solve,
+    close the arm; print the outcome (one JSON object with ``--json``). A suction fault is re-raised (exit 3)
+    after its outcome is printed."""
+    from ur3hanoi.errors import SuctionFaultError
+    from ur3hanoi.remote.solve import LabSolveConfig, run_lab_solve
+
+    say = say_for(args)
+    try:
+        arm.connect()
+        say(connected)
+        try:
+            result = run_lab_solve(arm, job.Q, job.home, job.start, job.end, job.n_blocks,
+                                   LabSolveConfig(args.grasp_timeout), log=say)
+        except SuctionFaultError as exc:
+            outcome.update(status="halted", exit_code=exc.exit_code, error=str(exc), commands=arm.commands_sent)
+            if args.json:
+                print(json.dumps(outcome))
+            raise
+    finally:
+        arm.close()
+    outcome.update(status="solved", exit_code=0, moves=len(result.moves), wall_time_s=round(result.wall_time_s, 3),
+                   commands=arm.commands_sent)
+    if args.json:
+        print(json.dumps(outcome))
+    else:
+        print(f"solved: {len(result.moves)} moves, tower {job.start + 1} -> {job.end + 1}, {arm.commands_sent} "
+              f"commands in {result.wall_time_s:.1f} s")
+    return 0
