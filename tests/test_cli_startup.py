@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 from ur3hanoi.cli import build_parser
 from ur3hanoi.cli.options import TABLE_KEYS
@@ -80,3 +81,22 @@ def test_python_m_ur3hanoi_is_the_command() -> None:
     assert proc.returncode == 2
     assert proc.stderr.startswith("ur3hanoi: error: argument --blocks:"), proc.stderr
     assert "ur3hanoi plan --help" in proc.stderr
+
+
+_RUN_PROBE = """
+import contextlib, io, json, sys
+import ur3hanoi.cli
+with contextlib.redirect_stdout(io.StringIO()):
+    code = ur3hanoi.cli.main({argv!r})
+print(json.dumps([code, sorted(m for m in sys.modules if m.split(".")[0] in {heavy!r})]))
+"""
+
+
+def test_tables_on_a_shipped_station_needs_no_pinocchio(tmp_path: Path) -> None:
+    """The closed form solves every pose of a shipped station within 1e-9 m / rad, measured by the NumPy FK of the
+    URDF chain: ``tables`` imports neither Pinocchio (nor coal, placo) nor anything else heavy but NumPy and YAML."""
+    for station, key in (("lab_sim", "sim_pos"), ("lab_real", "real_pos")):
+        argv = ["tables", station, "--key", key, "-o", str(tmp_path / "lab2_data.yaml")]
+        code, loaded = _probe(_RUN_PROBE.format(argv=argv, heavy=HEAVY))  # type: ignore[misc]
+        assert code == 0
+        assert {m.split(".")[0] for m in loaded} == {"numpy", "yaml"}, loaded

@@ -15,7 +15,7 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import TableError, printable
-from ur3hanoi.grid import POSE_NAMES, T_base_tcp, T_world_tcp
+from ur3hanoi.grid import POSE_NAMES, H_base_tcp, T_world_tcp
 from ur3hanoi.ik import IKResult, IKSolver, branch_of, make_solver, pose_errors, solve_on_branch
 from ur3hanoi.robot import N_JOINTS, load_ur3
 from ur3hanoi.station import Station
@@ -61,7 +61,7 @@ def generate_table(station: Station, solver: str | IKSolver = "pinocchio") -> Ta
     for t in range(station.n_towers):
         for h in range(station.n_heights):
             for k in (0, 1):
-                res = solve_on_branch(solver, T_base_tcp(station, t, h, k), station.q_home_array,
+                res = solve_on_branch(solver, H_base_tcp(station, t, h, k), station.q_home_array,
                                       label=f"{station.source}: {pose_label(t, h, k)}", home_branch=home_branch)
                 q[t, h, k] = res.q
                 results.append(res)
