@@ -389,6 +389,13 @@ class Ur3Model:
             self.model, self.data, np.asarray(q, dtype=float), self.frame_ids[frame], pin.LOCAL
         )
 
+    def H_flange_tcp(self, flange: str = "tool0") -> FloatArray:
+        """:meth:`T_flange_tcp` as a 4x4 matrix, from the URDF chain (no Pinocchio)."""
+        if flange not in FLANGE_FRAMES:
+            raise Ur3HanoiError(f"flange frame {flange!r} is invalid: expected one of {FLANGE_FRAMES}")
+        f = self.chain.frames
+        return rigid_inverse(f[flange][1]) @ f["tcp"][1]
+
     def T_flange_tcp(self, flange: str = "tool0") -> pin.SE3:
         """The constant TCP pose in a flange frame (``tool0`` or ``ee_link``)."""
         f = self.model.frames
