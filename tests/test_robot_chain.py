@@ -61,3 +61,47 @@ def test_a_branching_or_prismatic_urdf_is_refused() -> None:
         parse_chain(text)
     with pytest.raises(Ur3HanoiError, match="not XML"):
         parse_chain("<robot")
+
+
+def test_constants_are_pinocchios_to_the_last_bit() -> None:
+    """What a table's IK reads is computed in Pinocchio's own order of operations: the joint placements, the TCP
+    offset, the base pose's rotation are Pinocchio's bit for bit (a table, and every plan built on it, is the same
+    with or without Pinocchio imported)."""
+    import pinocchio as pin
+
+    rng = np.random.default_rng(7)
+    tools = [*TOOLS, *(ToolOffset(str(rng.choice(["ee_link", "tool0"])), tuple(rng.uniform(-0.1, 0.1, 3)),
+                                  tuple(rng.uniform(-3.2, 3.2, 3))) for _ in range(10))]
+    for robot in (UR3, UR3E):
+        for tool in tools:
+            model = Ur3Model(tool, robot=robot)  # type: ignore[arg-type]
+            for i in range(6):
+                np.testing.assert_array_equal(model.chain.joint_placements[i],
+                                              model.model.jointPlacements[i + 1].homogeneous)
+            np.testing.assert_array_equal(model.H_tcp_tool0, model.T_flange_tcp("tool0").inverse().homogeneous)
+            for flange in ("tool0", "ee_link"):
+                np.testing.assert_array_equal(model.H_flange_tcp(flange), model.T_flange_tcp(flange).homogeneous)
+    for rpy in rng.uniform(-3.5, 3.5, size=(500, 3)):
+        np.testing.assert_array_equal(rpy_matrix(*rpy), pin.rpy.rpyToMatrix(*rpy))
+
+
+def test_table_equals_the_pinocchio_pose_chain_bit_for_bit(lab_real: object) -> None:
+    """generate_table (NumPy poses) gives the very bits of the closed form fed by Pinocchio's SE3 poses, also on a
+    tilted base."""
+    import dataclasses
+
+    from ur3hanoi.grid import T_base_tcp
+    from ur3hanoi.ik import analytic_ik, branch_of, nearest_equivalent
+    from ur3hanoi.robot import load_ur3
+    from ur3hanoi.waypoints import generate_table
+
+    for station in (lab_real, dataclasses.replace(lab_real, base_rpy=(0.003, -0.002, 0.12))):  # type: ignore[type-var]
+        robot = load_ur3(station.tool, station.limits, station.robot)
+        table = generate_table(station).q
+        home = branch_of(station.q_home_array)
+        for t in range(station.n_towers):
+            for h in range(station.n_heights):
+                for k in (0, 1):
+                    T = T_base_tcp(station, t, h, k) * robot.T_flange_tcp("tool0").inverse()
+                    q = nearest_equivalent(analytic_ik(T, only=home)[home], station.q_home_array, station.limits)
+                    np.testing.assert_array_equal(table[t, h, k], q)

@@ -13,7 +13,7 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
-from ur3hanoi.robot_chain import rigid_inverse
+from ur3hanoi.robot_chain import se3_act_inv
 from ur3hanoi.station import Station
 
 if TYPE_CHECKING:
@@ -59,8 +59,8 @@ def H_world_tcp(station: Station, tower: int, height: int, k: int) -> FloatArray
 
 
 def H_base_tcp(station: Station, tower: int, height: int, k: int) -> FloatArray:
-    """:func:`T_base_tcp` as a 4x4 matrix (NumPy only: what a table's IK solves for)."""
-    return rigid_inverse(station.H_world_base) @ H_world_tcp(station, tower, height, k)
+    """:func:`T_base_tcp` as a 4x4 matrix (NumPy only, the same bits: what a table's IK solves for)."""
+    return se3_act_inv(station.H_world_base, H_world_tcp(station, tower, height, k))
 
 
 def T_world_tcp(station: Station, tower: int, height: int, k: int) -> pin.SE3:

@@ -23,6 +23,7 @@ import numpy as np
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import IKError, Ur3HanoiError
 from ur3hanoi.robot import DH_A, DH_D, JointLimits, Ur3Model, dh_link
+from ur3hanoi.robot_chain import se3_mul
 from ur3hanoi.robot_registry import DHParameters
 
 if TYPE_CHECKING:
@@ -349,7 +350,7 @@ def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3 | FloatArray, q_home: 
     if home_branch is None:
         home_branch = branch_of(q_home, robot.dh)
     H_base_tcp = as_matrix(T_base_tcp)
-    T_base_tool0 = H_base_tcp @ robot.H_tcp_tool0
+    T_base_tool0 = se3_mul(H_base_tcp, robot.H_tcp_tool0)  # Pinocchio's SE3 product, to the last bit
 
     def where() -> str:
         import pinocchio as pin

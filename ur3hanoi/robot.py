@@ -26,7 +26,7 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
-from ur3hanoi.robot_chain import UrdfChain, parse_chain, rigid_inverse
+from ur3hanoi.robot_chain import UrdfChain, parse_chain, rigid_inverse, se3_act_inv
 from ur3hanoi.robot_registry import CB3_CONTROL_PERIOD_S, UR3, DHParameters, RobotDescription
 
 if TYPE_CHECKING:
@@ -329,7 +329,7 @@ class Ur3Model:
         f = self.chain.frames
         if f["tcp"][0] != f["tool0"][0]:
             raise Ur3HanoiError(f"{robot.urdf_file or robot.name}: the tcp and tool0 links are not on the same link")
-        self.H_tcp_tool0: FloatArray = rigid_inverse(rigid_inverse(f["tool0"][1]) @ f["tcp"][1])
+        self.H_tcp_tool0: FloatArray = rigid_inverse(se3_act_inv(f["tool0"][1], f["tcp"][1]))
 
     @cached_property
     def model(self) -> pin.Model:
@@ -394,7 +394,7 @@ class Ur3Model:
         if flange not in FLANGE_FRAMES:
             raise Ur3HanoiError(f"flange frame {flange!r} is invalid: expected one of {FLANGE_FRAMES}")
         f = self.chain.frames
-        return rigid_inverse(f[flange][1]) @ f["tcp"][1]
+        return se3_act_inv(f[flange][1], f["tcp"][1])
 
     def T_flange_tcp(self, flange: str = "tool0") -> pin.SE3:
         """The constant TCP pose in a flange frame (``tool0`` or ``ee_link``)."""

@@ -5,7 +5,10 @@ for that costs more than the whole rest of ``ur3hanoi tables``. :func:`parse_cha
 same text Pinocchio builds its model from, with the ``tcp`` frame), merges fixed joints into the placements the way
 Pinocchio does (a frame's placement in its parent joint's frame), and :meth:`UrdfChain.fk` composes them: the
 result equals Pinocchio's ``framesForwardKinematics`` to rounding (tests/test_robot_chain.py compares them on seeded
-random configurations). Pinocchio stays the reference model of :class:`ur3hanoi.robot.Ur3Model` (Jacobians,
+random configurations). The constant placements (URDF ``rpy`` through urdfdom's quaternion, fixed joints merged) and
+the pose products a table's IK reads (:func:`se3_mul`, :func:`se3_act_inv`, :func:`rigid_inverse`,
+:func:`rpy_matrix`) follow Pinocchio's order of operations, so they are its numbers bit for bit: a table and every
+plan built on it do not change with the path that computed them. Pinocchio stays the reference model of :class:`ur3hanoi.robot.Ur3Model` (Jacobians,
 collision geometry, the numerical IK refiners).
 
 Frames: every placement is in the URDF root link's frame (``base_link`` for the UR URDFs, whose ``world`` link is
@@ -23,28 +26,89 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
 
 
+def _quaternion_product(a: tuple[float, float, float, float],
+                        b: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+            aw * by + ay * bw + az * bx - ax * bz, aw * bz + az * bw + ax * by - ay * bx)
+
+
+def _quaternion_matrix(w: float, x: float, y: float, z: float) -> FloatArray:
+    """Eigen's ``Quaternion::toRotationMatrix`` of a unit quaternion."""
+    tx, ty, tz = 2 * x, 2 * y, 2 * z
+    twx, twy, twz = tx * w, ty * w, tz * w
+    txx, txy, txz = tx * x, ty * x, tz * x
+    tyy, tyz, tzz = ty * y, tz * y, tz * z
+    return np.array([[1 - (tyy + tzz), txy - twz, txz + twy],
+                     [txy + twz, 1 - (txx + tzz), tyz - twx],
+                     [txz - twy, tyz + twx, 1 - (txx + tyy)]])
+
+
 def rpy_matrix(roll: float, pitch: float, yaw: float) -> FloatArray:
-    """URDF roll-pitch-yaw [rad] (fixed axes x, y, z) as a rotation matrix: ``Rz(yaw) Ry(pitch) Rx(roll)``."""
-    cr, sr = math.cos(roll), math.sin(roll)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-                     [-sp, cp * sr, cp * cr]])
+    """Roll-pitch-yaw [rad] (fixed axes x, y, z) as a rotation matrix, ``Rz(yaw) Ry(pitch) Rx(roll)``, computed as
+    ``pin.rpy.rpyToMatrix`` does (the product of three axis-angle quaternions), so that it equals it to the last bit
+    (tests/test_robot_chain.py)."""
+    def half(angle: float, axis: int) -> tuple[float, float, float, float]:
+        s, c = math.sin(0.5 * angle), math.cos(0.5 * angle)
+        return (c, s if axis == 0 else 0.0, s if axis == 1 else 0.0, s if axis == 2 else 0.0)
+
+    return _quaternion_matrix(*_quaternion_product(_quaternion_product(half(yaw, 2), half(pitch, 1)), half(roll, 0)))
+
+
+def urdf_rotation(roll: float, pitch: float, yaw: float) -> FloatArray:
+    """The rotation a URDF ``rpy`` makes in Pinocchio, to the last bit: urdfdom's quaternion of the half angles
+    (normalised), then Eigen's quaternion-to-matrix formula. Equal to :func:`rpy_matrix` to rounding."""
+    phi, the, psi = roll / 2.0, pitch / 2.0, yaw / 2.0
+    sphi, cphi, sthe, cthe, spsi, cpsi = (math.sin(phi), math.cos(phi), math.sin(the), math.cos(the), math.sin(psi),
+                                          math.cos(psi))
+    x = sphi * cthe * cpsi - cphi * sthe * spsi
+    y = cphi * sthe * cpsi + sphi * cthe * spsi
+    z = cphi * cthe * spsi - sphi * sthe * cpsi
+    w = cphi * cthe * cpsi + sphi * sthe * spsi
+    n = math.sqrt(x * x + y * y + z * z + w * w)
+    if n != 0.0:
+        x, y, z, w = x / n, y / n, z / n, w / n
+    return _quaternion_matrix(w, x, y, z)
+
+
+def se3_mul(A: FloatArray, B: FloatArray) -> FloatArray:
+    """``A B`` of two 4x4 rigid transforms in the order of Eigen's products (``R_A R_B``, ``R_A p_B + p_A``, each sum
+    left to right), so that it equals Pinocchio's ``SE3`` product to the last bit."""
+    (a00, a01, a02, a03), (a10, a11, a12, a13), (a20, a21, a22, a23) = A[:3].tolist()
+    (b00, b01, b02, b03), (b10, b11, b12, b13), (b20, b21, b22, b23) = B[:3].tolist()
+    return np.array([
+        [a00 * b00 + a01 * b10 + a02 * b20, a00 * b01 + a01 * b11 + a02 * b21, a00 * b02 + a01 * b12 + a02 * b22,
+         (a00 * b03 + a01 * b13 + a02 * b23) + a03],
+        [a10 * b00 + a11 * b10 + a12 * b20, a10 * b01 + a11 * b11 + a12 * b21, a10 * b02 + a11 * b12 + a12 * b22,
+         (a10 * b03 + a11 * b13 + a12 * b23) + a13],
+        [a20 * b00 + a21 * b10 + a22 * b20, a20 * b01 + a21 * b11 + a22 * b21, a20 * b02 + a21 * b12 + a22 * b22,
+         (a20 * b03 + a21 * b13 + a22 * b23) + a23],
+        [0.0, 0.0, 0.0, 1.0]])
+
+
+def se3_act_inv(A: FloatArray, B: FloatArray) -> FloatArray:
+    """``inv(A) B`` as Pinocchio's ``A.actInv(B)`` computes it (``R_A^T R_B``, ``R_A^T (p_B - p_A)``)."""
+    At = np.eye(4)
+    At[:3, :3] = A[:3, :3].T
+    Bs = B.copy()
+    Bs[:3, 3] = B[:3, 3] - A[:3, 3]
+    return se3_mul(At, Bs)
 
 
 def rigid_inverse(T: FloatArray) -> FloatArray:
-    """Inverse of a 4x4 rigid transform: ``(R^T, -R^T p)``."""
-    out = np.eye(4)
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -(T[:3, :3].T @ T[:3, 3])
-    return out
+    """Inverse of a 4x4 rigid transform: ``(R^T, -R^T p)``, each sum left to right (Pinocchio's ``SE3.inverse``)."""
+    (r00, r01, r02, p0), (r10, r11, r12, p1), (r20, r21, r22, p2) = T[:3].tolist()
+    return np.array([[r00, r10, r20, -(r00 * p0 + r10 * p1 + r20 * p2)],
+                     [r01, r11, r21, -(r01 * p0 + r11 * p1 + r21 * p2)],
+                     [r02, r12, r22, -(r02 * p0 + r12 * p1 + r22 * p2)],
+                     [0.0, 0.0, 0.0, 1.0]])
 
 
 def _placement(xyz: str | None, rpy: str | None) -> FloatArray:
     T = np.eye(4)
     if rpy:
-        T[:3, :3] = rpy_matrix(*(float(v) for v in rpy.split()))
+        T[:3, :3] = urdf_rotation(*(float(v) for v in rpy.split()))
     if xyz:
         T[:3, 3] = [float(v) for v in xyz.split()]
     return T
@@ -145,16 +209,17 @@ def parse_chain(urdf: str) -> UrdfChain:
         frames[link] = (parent_joint, T_joint_link)
         for name, child, T, axis in children.get(link, []):
             if axis is None:
-                stack.append((child, parent_joint, T_joint_link @ T))
+                stack.append((child, parent_joint, se3_mul(T_joint_link, T)))
                 continue
             if parent_joint != len(names):
                 raise Ur3HanoiError(f"URDF joint {name!r} starts a second movable chain: expected a serial arm")
             names.append(name)
-            placements.append(T_joint_link @ T)
+            placements.append(se3_mul(T_joint_link, T))
             axes.append(axis)
             stack.append((child, len(names), np.eye(4)))
     # The root link is Pinocchio's universe: a fixed world link moves nothing, so frames stay in the root's frame.
     return UrdfChain(tuple(names), tuple(placements), tuple(axes), frames)
 
 
-__all__ = ["UrdfChain", "axis_rotation", "parse_chain", "rigid_inverse", "rpy_matrix"]
+__all__ = ["UrdfChain", "axis_rotation", "parse_chain", "rigid_inverse", "rpy_matrix", "se3_act_inv", "se3_mul",
+           "urdf_rotation"]
