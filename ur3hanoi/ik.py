@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
@@ -396,3 +397,29 @@ def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3 | FloatArray, q_home: 
     return res
 
 
+def solve_table_on_branch(solver: IKSolver, targets: Sequence[pin.SE3 | FloatArray], q_home: FloatArray,
+                          labels: Sequence[str], home_branch: Branch | None = None) -> list[IKResult]:
+    """:func:`solve_on_branch` of every pose of ``targets`` (``T_base_tcp``), the same results, with the closed
+    form's FK check done for all poses in one NumPy pass (a table is 18 poses; most need no refinement). A pose
+    without a closed-form solution on home's branch, or whose residual exceeds the tolerances, goes through
+    :func:`solve_on_branch` (its refinement, or its error naming ``labels[i]``)."""
+    robot = solver.robot
+    q_home = np.asarray(q_home, dtype=float)
+    if home_branch is None:
+        home_branch = branch_of(q_home, robot.dh)
+    H = [as_matrix(T) for T in targets]
+    seeds: list[FloatArray | None] = []
+    for H_base_tcp in H:
+        branches = analytic_ik(se3_mul(H_base_tcp, robot.H_tcp_tool0), only=home_branch, dh=robot.dh)
+        seeds.append(nearest_equivalent(branches[home_branch], q_home, robot.limits) if branches else None)
+    ok = [i for i, q in enumerate(seeds) if q is not None]
+    reached = robot.fk_matrix(np.array([seeds[i] for i in ok]).reshape(-1, 6), "tcp")
+    results: dict[int, IKResult] = {}
+    for i, H_reached in zip(ok, reached, strict=True):
+        dp, dr = pose_errors(H_reached, H[i])
+        res = IKResult(q=seeds[i], position_error=dp, orientation_error=dr, iterations=0,  # type: ignore[arg-type]
+                       solver=CLOSED_FORM)
+        if res.converged:
+            results[i] = res
+    return [results[i] if i in results else solve_on_branch(solver, targets[i], q_home, labels[i], home_branch)
+            for i in range(len(H))]

@@ -374,8 +374,8 @@ class Ur3Model:
         return _se3("T_BASE_BASELINK") * self.data.oMf[fid]
 
     def fk_matrix(self, q: FloatArray, frame: str = "tcp") -> FloatArray:
-        """4x4 pose of ``frame`` in the controller ``base`` frame at ``q`` [rad]: the NumPy FK of the URDF chain,
-        equal to :meth:`fk` to rounding (no Pinocchio)."""
+        """4x4 pose of ``frame`` in the controller ``base`` frame at ``q`` [rad] ((N, 4, 4) for ``q`` of shape
+        (N, 6)): the NumPy FK of the URDF chain, equal to :meth:`fk` to rounding (no Pinocchio)."""
         if frame not in ("base", "base_link", "tool0", "tcp", "ee_link"):
             raise Ur3HanoiError(f"frame {frame!r} is unknown: expected one of "
                                 f"{sorted(('base', 'base_link', 'tool0', 'tcp', 'ee_link'))}")

@@ -18,7 +18,7 @@ fixed to it at the identity).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -150,16 +150,34 @@ class UrdfChain:
     joint_placements: tuple[FloatArray, ...]
     axes: tuple[FloatArray, ...]
     frames: dict[str, tuple[int, FloatArray]]
+    _terms: tuple[FloatArray, FloatArray, FloatArray] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        # P Rot(axis, q) = P + sin q (P K) + (1 - cos q) (P K^2) with K the axis's cross-product matrix (Rodrigues):
+        # every joint's transform from two scalars, all joints in one NumPy expression.
+        P = np.array(self.joint_placements).reshape(-1, 4, 4)
+        K = np.zeros((len(self.axes), 4, 4))
+        for i, (x, y, z) in enumerate(a.tolist() for a in self.axes):
+            K[i, :3, :3] = [[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]]
+        object.__setattr__(self, "_terms", (P, P @ K, P @ K @ K))
 
     def fk(self, q: FloatArray, frame: str) -> FloatArray:
-        """4x4 pose of link ``frame`` in the root link's frame at joint angles ``q`` [rad]."""
+        """4x4 pose of link ``frame`` in the root link's frame at joint angles ``q`` [rad]; ``q`` of shape (N, n)
+        gives (N, 4, 4) (one NumPy pass for a whole table)."""
         try:
             parent, placement = self.frames[frame]
         except KeyError:
             raise Ur3HanoiError(f"frame {frame!r} is unknown: expected one of {sorted(self.frames)}") from None
-        T = np.eye(4)
-        for i, angle in enumerate(np.asarray(q, dtype=float).tolist()[:parent]):
-            T = T @ self.joint_placements[i] @ axis_rotation(self.axes[i], angle)
+        q = np.asarray(q, dtype=float)
+        if parent == 0:
+            return np.broadcast_to(placement, (*q.shape[:-1], 4, 4)).copy()
+        angles = q[..., :parent]
+        P, PK, PK2 = self._terms
+        A = P[:parent] + np.sin(angles)[..., None, None] * PK[:parent] + (1.0 - np.cos(angles))[..., None, None] * \
+            PK2[:parent]
+        T = A[..., 0, :, :]
+        for i in range(1, parent):
+            T = T @ A[..., i, :, :]
         return T @ placement
 
 
