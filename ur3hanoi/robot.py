@@ -328,7 +328,8 @@ class Ur3Model:
         # The flange seen from the TCP: constant, used by every IK solve to turn a TCP target into a flange one.
         f = self.chain.frames
         if f["tcp"][0] != f["tool0"][0]:
-            raise Ur3HanoiError(f"{robot.urdf_file or robot.name}: the tcp and tool0 links are not on the same link")
+            raise Ur3HanoiError(f"{robot.urdf_file or robot.name}: the tcp and tool0 links are not fixed to the same "
+                                "joint")
         self.H_tcp_tool0: FloatArray = rigid_inverse(se3_act_inv(f["tool0"][1], f["tcp"][1]))
 
     @cached_property

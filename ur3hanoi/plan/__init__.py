@@ -23,7 +23,8 @@ Package map (dependencies flow downward only; each module is one concept):
 - ``checks/``: what a plan must satisfy. :mod:`~ur3hanoi.plan.checks.limits` joint limits;
   :mod:`~ur3hanoi.plan.checks.vertical` the 2 mm vertical line; :mod:`~ur3hanoi.plan.checks.suction` what the
   suction holds while carrying; :mod:`~ur3hanoi.plan.checks.collision` the clearance rules and
-  :func:`check_collisions`; :mod:`~ur3hanoi.plan.checks.clearance` the planner's per-segment clearance check.
+  :func:`check_collisions`; :mod:`~ur3hanoi.plan.checks.clearance` the planner's per-segment clearance check;
+  :mod:`~ur3hanoi.plan.checks.stored` its result in the user's cache.
 - ``baseline/``: :mod:`~ur3hanoi.plan.baseline.lab_program` the lab's own program on the same moves (movej per
   waypoint, its waits); :mod:`~ur3hanoi.plan.baseline.stop_and_go` the stop-and-go references between the same
   waypoints.
