@@ -100,3 +100,22 @@ def test_tables_on_a_shipped_station_needs_no_pinocchio(tmp_path: Path) -> None:
         code, loaded = _probe(_RUN_PROBE.format(argv=argv, heavy=HEAVY))  # type: ignore[misc]
         assert code == 0
         assert {m.split(".")[0] for m in loaded} == {"numpy", "yaml"}, loaded
+
+
+def test_a_plan_from_the_user_cache_needs_no_pinocchio_coal_or_scipy(tmp_path: Path) -> None:
+    """The second ``plan`` of a station reads its connections, waypoints and clearance result from the user's cache:
+    it imports neither Pinocchio nor coal (the clearance check) nor SciPy (the search), nor MuJoCo or placo."""
+    import os
+
+    argv = ["plan", "--start", "1", "--end", "3", "--calibration", "lab_sim"]
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "xdg")}
+    runs = []
+    for _ in range(2):
+        proc = subprocess.run([sys.executable, "-c", _RUN_PROBE.format(argv=argv, heavy=HEAVY)], capture_output=True,
+                              text=True, cwd=REPO, timeout=300, env=env)
+        assert proc.returncode == 0, proc.stderr
+        runs.append(json.loads(proc.stdout))
+    (code_first, first), (code, loaded) = runs
+    assert code_first == code == 0
+    assert {"pinocchio", "coal"} <= {m.split(".")[0] for m in first}  # the first run checks the clearances
+    assert {m.split(".")[0] for m in loaded} == {"numpy", "yaml", "ruckig"}, loaded
