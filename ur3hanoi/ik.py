@@ -9,7 +9,12 @@
   URDF model and refined by the numerical solver only when its residual exceeds :data:`POSITION_TOL` /
   :data:`ORIENTATION_TOL` (the closed form alone is about 1e-12 m accurate on the UR3, and several times
   faster); then it requires the home branch and the 2pi-equivalent of every joint nearest to home within
-  limits, so moves between waypoints never flip the arm.
+  limits, so moves between waypoints never flip the arm. :func:`solve_table_on_branch` does the same for a whole
+  table with one FK pass.
+
+Poses are ``pin.SE3`` or 4x4 matrices. The closed form and its FK check use NumPy only (the URDF chain of
+:mod:`ur3hanoi.robot_chain`, Pinocchio's numbers): Pinocchio (and placo) are imported only when a pose needs a
+refinement or an error message names a pose's roll-pitch-yaw.
 """
 
 from __future__ import annotations
@@ -175,7 +180,7 @@ def nearest_equivalent(q: FloatArray, q_ref: FloatArray, limits: JointLimits) ->
 
 @dataclass(frozen=True)
 class IKResult:
-    """Outcome of one IK solve. ``q`` [rad]; errors measured by Pinocchio FK of the ``tcp`` frame.
+    """Outcome of one IK solve. ``q`` [rad]; errors measured by FK of the ``tcp`` frame (the URDF model's).
 
     ``solver`` is :data:`CLOSED_FORM` (``iterations`` 0) when the closed form was accurate enough, else the name
     of the numerical solver that refined it.
