@@ -13,7 +13,6 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
-from ur3hanoi.robot_chain import se3_act_inv
 from ur3hanoi.station import Station
 
 if TYPE_CHECKING:
@@ -47,7 +46,8 @@ def contact_point_world(station: Station, tower: int, height: int) -> FloatArray
 
 
 def H_world_tcp(station: Station, tower: int, height: int, k: int) -> FloatArray:
-    """Target pose of the suction point (TCP) in world for (tower, height, k), as a 4x4 matrix."""
+    """Target pose of the suction point (TCP) in world for (tower, height, k), as a 4x4 matrix (NumPy only; in
+    ``base``: ``robot_chain.se3_act_inv(station.H_world_base, H)``, :func:`T_base_tcp`'s numbers bit for bit)."""
     check_index(station, tower, height, k)
     p = contact_point_world(station, tower, height)
     if k == ABOVE:
@@ -56,11 +56,6 @@ def H_world_tcp(station: Station, tower: int, height: int, k: int) -> FloatArray
     H[:3, :3] = R_world_tcp_down(station.tool_yaw)
     H[:3, 3] = p
     return H
-
-
-def H_base_tcp(station: Station, tower: int, height: int, k: int) -> FloatArray:
-    """:func:`T_base_tcp` as a 4x4 matrix (NumPy only, the same bits: what a table's IK solves for)."""
-    return se3_act_inv(station.H_world_base, H_world_tcp(station, tower, height, k))
 
 
 def T_world_tcp(station: Station, tower: int, height: int, k: int) -> pin.SE3:

@@ -126,7 +126,7 @@ class Station:
 
     @property
     def H_world_base(self) -> FloatArray:
-        """:attr:`T_world_base` as a 4x4 matrix (NumPy only)."""
+        """:attr:`T_world_base` as a 4x4 matrix (NumPy only, the same bits)."""
         H = np.eye(4)
         H[:3, :3] = rpy_matrix(*self.base_rpy)
         H[:3, 3] = self.base_xyz
