@@ -8,8 +8,9 @@ result equals Pinocchio's ``framesForwardKinematics`` to rounding (tests/test_ro
 random configurations). The constant placements (URDF ``rpy`` through urdfdom's quaternion, fixed joints merged) and
 the pose products a table's IK reads (:func:`se3_mul`, :func:`se3_act_inv`, :func:`rigid_inverse`,
 :func:`rpy_matrix`) follow Pinocchio's order of operations, so they are its numbers bit for bit where its build
-fuses no multiply-adds (x86-64): a table and every plan built on it do not change with the path that computed them. Pinocchio stays the reference model of
-:class:`ur3hanoi.robot.Ur3Model` (Jacobians, collision geometry, the numerical IK refiners).
+fuses no multiply-adds (x86-64): a table and every plan built on it do not change with the path that computed
+them. Pinocchio stays the reference model of :class:`ur3hanoi.robot.Ur3Model` (Jacobians, collision geometry, the
+numerical IK refiners).
 
 Frames: every placement is in the URDF root link's frame (``base_link`` for the UR URDFs, whose ``world`` link is
 fixed to it at the identity).
