@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 from ur3hanoi.cli import build_parser
 from ur3hanoi.cli.options import TABLE_KEYS
@@ -80,3 +81,41 @@ def test_python_m_ur3hanoi_is_the_command() -> None:
     assert proc.returncode == 2
     assert proc.stderr.startswith("ur3hanoi: error: argument --blocks:"), proc.stderr
     assert "ur3hanoi plan --help" in proc.stderr
+
+
+_RUN_PROBE = """
+import contextlib, io, json, sys
+import ur3hanoi.cli
+with contextlib.redirect_stdout(io.StringIO()):
+    code = ur3hanoi.cli.main({argv!r})
+print(json.dumps([code, sorted(m for m in sys.modules if m.split(".")[0] in {heavy!r})]))
+"""
+
+
+def test_tables_on_a_shipped_station_needs_no_pinocchio(tmp_path: Path) -> None:
+    """The closed form solves every pose of a shipped station within 1e-9 m / rad, measured by the NumPy FK of the
+    URDF chain: ``tables`` imports neither Pinocchio (nor coal, placo) nor anything else heavy but NumPy and YAML."""
+    for station, key in (("lab_sim", "sim_pos"), ("lab_real", "real_pos")):
+        argv = ["tables", station, "--key", key, "-o", str(tmp_path / "lab2_data.yaml")]
+        code, loaded = _probe(_RUN_PROBE.format(argv=argv, heavy=HEAVY))  # type: ignore[misc]
+        assert code == 0
+        assert {m.split(".")[0] for m in loaded} == {"numpy", "yaml"}, loaded
+
+
+def test_a_plan_from_the_user_cache_needs_no_pinocchio_coal_or_scipy(tmp_path: Path) -> None:
+    """The second ``plan`` of a station reads its connections, waypoints and clearance result from the user's cache:
+    it imports neither Pinocchio nor coal (the clearance check) nor SciPy (the search), nor MuJoCo or placo."""
+    import os
+
+    argv = ["plan", "--start", "1", "--end", "3", "--calibration", "lab_sim"]
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "xdg")}
+    runs = []
+    for _ in range(2):
+        proc = subprocess.run([sys.executable, "-c", _RUN_PROBE.format(argv=argv, heavy=HEAVY)], capture_output=True,
+                              text=True, cwd=REPO, timeout=300, env=env)
+        assert proc.returncode == 0, proc.stderr
+        runs.append(json.loads(proc.stdout))
+    (code_first, first), (code, loaded) = runs
+    assert code_first == code == 0
+    assert {"pinocchio", "coal"} <= {m.split(".")[0] for m in first}  # the first run checks the clearances
+    assert {m.split(".")[0] for m in loaded} == {"numpy", "yaml", "ruckig"}, loaded

@@ -29,6 +29,7 @@ from ur3hanoi.ik import (
     nearest_equivalent,
     pose_errors,
     solve_on_branch,
+    solve_table_on_branch,
     wrap_angle,
 )
 from ur3hanoi.robot import Q_HOME_LAB, JointLimits, Ur3Model, dh_fk, load_ur3
@@ -279,3 +280,30 @@ def test_refined_where_the_closed_form_misses(longer_arm: Ur3Model, lab_sim: Sta
                 assert 1e-10 < np.abs(wrap_angle(res.q - q_closed)).max() < 1e-6  # moved, but stayed put
                 n += 1
     assert solver.calls == n == 18
+
+
+@pytest.mark.parametrize("arm", ["ur3", "longer_arm"])
+def test_table_solve_equals_pose_by_pose(arm: str, longer_arm: Ur3Model, lab_sim: Station) -> None:
+    """solve_table_on_branch (one FK pass for all poses) gives solve_on_branch's results pose by pose: the closed
+    form where it is within the tolerances (the UR3), the solver's refinement where it is not (a longer arm)."""
+    robot = load_ur3(lab_sim.tool, lab_sim.limits) if arm == "ur3" else longer_arm
+    solver = make_solver("pinocchio", robot)
+    targets = [T_base_tcp(lab_sim, t, h, k) for t in range(lab_sim.n_towers) for h in range(lab_sim.n_heights)
+               for k in (0, 1)]
+    table = solve_table_on_branch(solver, targets, lab_sim.q_home_array, [f"pose {i}" for i in range(18)])
+    for T, res in zip(targets, table, strict=True):
+        alone = solve_on_branch(solver, T, lab_sim.q_home_array)
+        np.testing.assert_array_equal(res.q, alone.q)
+        assert (res.solver, res.iterations) == (alone.solver, alone.iterations)
+        assert (res.position_error, res.orientation_error) == pytest.approx(
+            (alone.position_error, alone.orientation_error), abs=1e-14)
+    assert {r.solver for r in table} == ({CLOSED_FORM} if arm == "ur3" else {"pinocchio"})
+
+
+def test_table_solve_names_the_pose_it_cannot_reach(robot: Ur3Model, lab_sim: Station) -> None:
+    solver = make_solver("pinocchio", robot)
+    far = pin.SE3(R_world_tcp_down(0.0), np.array([0.9, 0.0, 0.1]))
+    targets = [T_base_tcp(lab_sim, 0, 0, 0), far, T_base_tcp(lab_sim, 1, 0, 0)]
+    with pytest.raises(IKError, match=r"second pose: target xyz \[0.9, 0.0, 0.1\].*unreachable"):
+        solve_table_on_branch(solver, targets, Q_HOME, ["first pose", "second pose", "third pose"])
+

@@ -98,6 +98,34 @@ def store(kind: str, key: str, payload: bytes) -> bool:
     return True
 
 
+def installed_versions(names: Iterable[str]) -> tuple[tuple[str, str | None], ...]:
+    """(name, version) of each installed distribution (``name`` as its ``.dist-info`` folder spells it, e.g.
+    ``example_robot_data``; None when not installed): read from the folder names on ``sys.path``, the first match
+    as ``importlib.metadata`` finds it, without importing it (or the library)."""
+    import sys
+
+    wanted = list(names)
+    found: dict[str, str] = {}
+    for entry in sys.path:
+        try:
+            listing = os.listdir(entry or ".")
+        except OSError:
+            continue
+        for item in listing:
+            if item.endswith(".dist-info"):
+                name, _, version = item[: -len(".dist-info")].partition("-")
+                if name in wanted and name not in found:
+                    found[name] = version
+    missing = [n for n in wanted if n not in found]
+    if missing:  # another kind of install (an .egg-info, a zip): ask importlib.metadata
+        import importlib.metadata
+
+        for n in missing:
+            with contextlib.suppress(importlib.metadata.PackageNotFoundError):
+                found[n] = importlib.metadata.version(n)
+    return tuple((n, found.get(n)) for n in wanted)
+
+
 T = TypeVar("T")
 
 

@@ -7,13 +7,16 @@ contact ("on") pose, 1 = the pose "in the air" above it (the order of the course
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
 from ur3hanoi.station import Station
+
+if TYPE_CHECKING:
+    import pinocchio as pin
 
 ON, ABOVE = 0, 1
 POSE_NAMES: tuple[str, str] = ("on", "above")
@@ -42,13 +45,24 @@ def contact_point_world(station: Station, tower: int, height: int) -> FloatArray
     return np.asarray(station.tower_origins[tower], dtype=float) + height * np.asarray(station.height_step)
 
 
-def T_world_tcp(station: Station, tower: int, height: int, k: int) -> pin.SE3:
-    """Target pose of the suction point (TCP) in world for (tower, height, k)."""
+def H_world_tcp(station: Station, tower: int, height: int, k: int) -> FloatArray:
+    """Target pose of the suction point (TCP) in world for (tower, height, k), as a 4x4 matrix (NumPy only; in
+    ``base``: ``robot_chain.se3_act_inv(station.H_world_base, H)``, :func:`T_base_tcp`'s numbers bit for bit)."""
     check_index(station, tower, height, k)
     p = contact_point_world(station, tower, height)
     if k == ABOVE:
         p = p + np.array([0.0, 0.0, station.approach])
-    return pin.SE3(R_world_tcp_down(station.tool_yaw), p)
+    H = np.eye(4)
+    H[:3, :3] = R_world_tcp_down(station.tool_yaw)
+    H[:3, 3] = p
+    return H
+
+
+def T_world_tcp(station: Station, tower: int, height: int, k: int) -> pin.SE3:
+    """Target pose of the suction point (TCP) in world for (tower, height, k)."""
+    import pinocchio as pin
+
+    return pin.SE3(H_world_tcp(station, tower, height, k))
 
 
 def T_base_tcp(station: Station, tower: int, height: int, k: int) -> pin.SE3:
@@ -62,7 +76,7 @@ def grid_targets_world(station: Station) -> FloatArray:
     for t in range(station.n_towers):
         for h in range(station.n_heights):
             for k in (ON, ABOVE):
-                out[t, h, k] = T_world_tcp(station, t, h, k).homogeneous
+                out[t, h, k] = H_world_tcp(station, t, h, k)
     return out
 
 

@@ -9,22 +9,31 @@
   URDF model and refined by the numerical solver only when its residual exceeds :data:`POSITION_TOL` /
   :data:`ORIENTATION_TOL` (the closed form alone is about 1e-12 m accurate on the UR3, and several times
   faster); then it requires the home branch and the 2pi-equivalent of every joint nearest to home within
-  limits, so moves between waypoints never flip the arm.
+  limits, so moves between waypoints never flip the arm. :func:`solve_table_on_branch` does the same for a whole
+  table with one FK pass.
+
+Poses are ``pin.SE3`` or 4x4 matrices. The closed form and its FK check use NumPy only (the URDF chain of
+:mod:`ur3hanoi.robot_chain`, Pinocchio's numbers): Pinocchio (and placo) are imported only when a pose needs a
+refinement or an error message names a pose's roll-pitch-yaw.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
-import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import IKError, Ur3HanoiError
-from ur3hanoi.robot import DH_A, DH_D, T_BASELINK_BASE, JointLimits, Ur3Model, dh_link
+from ur3hanoi.robot import DH_A, DH_D, JointLimits, Ur3Model, dh_link
+from ur3hanoi.robot_chain import se3_mul
 from ur3hanoi.robot_registry import DHParameters
+
+if TYPE_CHECKING:
+    import pinocchio as pin
 
 Branch = tuple[int, int, int]
 
@@ -40,11 +49,24 @@ def wrap_angle(x: FloatArray | float) -> FloatArray:
     return (np.asarray(x, dtype=float) + math.pi) % (2 * math.pi) - math.pi
 
 
-def pose_errors(T_actual: pin.SE3, T_target: pin.SE3) -> tuple[float, float]:
-    """(position error [m], orientation error [rad]) between two poses."""
-    dp = math.dist(T_actual.translation.tolist(), T_target.translation.tolist())
-    dR = T_actual.rotation.T @ T_target.rotation
-    return dp, math.hypot(*pin.log3(dR).tolist())
+def as_matrix(T: pin.SE3 | FloatArray) -> FloatArray:
+    """A pose as a 4x4 homogeneous matrix (a ``pin.SE3`` or a 4x4 array)."""
+    return T.homogeneous if hasattr(T, "homogeneous") else np.asarray(T, dtype=float)
+
+
+def rotation_angle(R: FloatArray) -> float:
+    """Angle [rad] of a rotation matrix (the norm of its log), accurate for tiny angles too: ``atan2`` of the
+    skew part's norm (the sine, to rounding) and ``(trace - 1) / 2`` (the cosine)."""
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R.tolist()
+    s = 0.5 * math.sqrt((r21 - r12) ** 2 + (r02 - r20) ** 2 + (r10 - r01) ** 2)
+    return math.atan2(s, 0.5 * (r00 + r11 + r22 - 1.0))
+
+
+def pose_errors(T_actual: pin.SE3 | FloatArray, T_target: pin.SE3 | FloatArray) -> tuple[float, float]:
+    """(position error [m], orientation error [rad]) between two poses (``pin.SE3`` or 4x4 matrices)."""
+    A, B = as_matrix(T_actual), as_matrix(T_target)
+    dp = math.dist(A[:3, 3].tolist(), B[:3, 3].tolist())
+    return dp, rotation_angle(A[:3, :3].T @ B[:3, :3])
 
 
 # ------------------------------------------------------------------------------------------------ branches
@@ -77,7 +99,7 @@ def branch_of(q: FloatArray, dh: DHParameters | None = None) -> Branch:
 BRANCHES: tuple[Branch, ...] = tuple((s, e, w) for s in (1, -1) for e in (1, -1) for w in (1, -1))
 
 
-def analytic_ik(T_base_tool0: FloatArray | pin.SE3, only: Branch | None = None,
+def analytic_ik(T_base_tool0: pin.SE3 | FloatArray, only: Branch | None = None,
                 dh: DHParameters | None = None) -> dict[Branch, FloatArray]:
     """Closed-form UR IK of a flange (``tool0``) pose in ``base``: ``{branch: q}`` for every reachable branch.
 
@@ -91,7 +113,7 @@ def analytic_ik(T_base_tool0: FloatArray | pin.SE3, only: Branch | None = None,
     u_z - d1)`` with ``u = p + d5 (s6 X + c6 Y) - d6 Z``, and x axis at angle q2 + q3 + q4 with cosine
     ``c1 w_x + s1 w_y`` and sine ``w_z``, ``w = c5 (c6 X - s6 Y) - s5 Z``.
     """
-    T = T_base_tool0.homogeneous if isinstance(T_base_tool0, pin.SE3) else np.asarray(T_base_tool0, dtype=float)
+    T = as_matrix(T_base_tool0)
     (xx, yx, zx, px), (xy, yy, zy, py), (xz, yz, zz, pz) = T[:3].tolist()
     D, A = (DH_D, DH_A) if dh is None else (dh.d, dh.a)
     d1, d4, d5, d6 = D[0], D[3], D[4], D[5]
@@ -158,7 +180,7 @@ def nearest_equivalent(q: FloatArray, q_ref: FloatArray, limits: JointLimits) ->
 
 @dataclass(frozen=True)
 class IKResult:
-    """Outcome of one IK solve. ``q`` [rad]; errors measured by Pinocchio FK of the ``tcp`` frame.
+    """Outcome of one IK solve. ``q`` [rad]; errors measured by FK of the ``tcp`` frame (the URDF model's).
 
     ``solver`` is :data:`CLOSED_FORM` (``iterations`` 0) when the closed form was accurate enough, else the name
     of the numerical solver that refined it.
@@ -181,7 +203,7 @@ class IKSolver(Protocol):
     name: str
     robot: Ur3Model
 
-    def solve(self, T_base_tcp: pin.SE3, q_seed: FloatArray) -> IKResult: ...
+    def solve(self, T_base_tcp: pin.SE3 | FloatArray, q_seed: FloatArray) -> IKResult: ...
 
 
 class PinocchioIK:
@@ -202,22 +224,26 @@ class PinocchioIK:
         self.max_iterations = max_iterations
         self.damping = damping
         self.stop_tol = stop_tol
-        self._fid = robot.frame_ids["tcp"]
         self._damping_eye = damping * np.eye(6)
 
-    def solve(self, T_base_tcp: pin.SE3, q_seed: FloatArray) -> IKResult:
+    def solve(self, T_base_tcp: pin.SE3 | FloatArray, q_seed: FloatArray) -> IKResult:
+        import pinocchio as pin
+
+        from ur3hanoi.robot import T_BASELINK_BASE
+
         model, data = self.robot.model, self.robot.data
+        fid = self.robot.frame_ids["tcp"]
         # Work in the URDF root frame (base_link) where Pinocchio's oMf lives.
-        target = T_BASELINK_BASE * T_base_tcp
+        target = T_BASELINK_BASE * pin.SE3(as_matrix(T_base_tcp))
         q = np.array(q_seed, dtype=float)
         it = 0
         for it in range(1, self.max_iterations + 1):
             pin.forwardKinematics(model, data, q)
-            iMd = pin.updateFramePlacement(model, data, self._fid).actInv(target)
+            iMd = pin.updateFramePlacement(model, data, fid).actInv(target)
             err = pin.log6(iMd).vector
             if math.sqrt(err @ err) < self.stop_tol:
                 break
-            J = pin.computeFrameJacobian(model, data, q, self._fid, pin.LOCAL)
+            J = pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL)
             J = -pin.Jlog6(iMd.inverse()) @ J
             dq = -J.T @ np.linalg.solve(J @ J.T + self._damping_eye, err)
             # Cap the step: far from the solution a full Gauss-Newton step can leap across branches.
@@ -227,7 +253,7 @@ class PinocchioIK:
             q = q + dq
         else:
             pin.forwardKinematics(model, data, q)
-            iMd = pin.updateFramePlacement(model, data, self._fid).actInv(target)
+            iMd = pin.updateFramePlacement(model, data, fid).actInv(target)
         # iMd is the target seen from the reached TCP: its translation norm is the position error.
         dp = float(np.linalg.norm(iMd.translation))
         dr = float(np.linalg.norm(pin.log3(iMd.rotation)))
@@ -246,12 +272,12 @@ class PlacoIK:
         self.robot = robot
         self.max_iterations = max_iterations
         self.stop_tol = stop_tol
-        self._names = list(self.robot.model.names[1:])
         self._built = False  # placo and its model are loaded on the first solve: a table rarely needs any
 
     def _build(self) -> None:
         import placo  # imported here: placo is heavy and only this solver needs it
 
+        self._names = list(self.robot.model.names[1:])
         self._robot = placo.RobotWrapper("", placo.Flags.ignore_collisions, self.robot.urdf)
         self._solver = placo.KinematicsSolver(self._robot)
         self._solver.mask_fbase(True)
@@ -261,9 +287,14 @@ class PlacoIK:
         self._task.configure("tcp", "soft", 1.0, 1.0)
         self._built = True
 
-    def solve(self, T_base_tcp: pin.SE3, q_seed: FloatArray) -> IKResult:
+    def solve(self, T_base_tcp: pin.SE3 | FloatArray, q_seed: FloatArray) -> IKResult:
+        import pinocchio as pin
+
+        from ur3hanoi.robot import T_BASELINK_BASE
+
         if not self._built:
             self._build()
+        T_base_tcp = pin.SE3(as_matrix(T_base_tcp))
         target = (T_BASELINK_BASE * T_base_tcp).homogeneous
         self._task.T_world_frame = target
         for name, v in zip(self._names, np.asarray(q_seed, dtype=float), strict=True):
@@ -290,14 +321,16 @@ def make_solver(name: str, robot: Ur3Model) -> IKSolver:
     raise Ur3HanoiError(f"IK solver {name!r} is unknown: expected one of {SOLVERS}")
 
 
-def closed_form_result(robot: Ur3Model, T_base_tcp: pin.SE3, q: FloatArray) -> IKResult:
+def closed_form_result(robot: Ur3Model, T_base_tcp: pin.SE3 | FloatArray, q: FloatArray) -> IKResult:
     """A closed-form solution ``q`` [rad] of ``T_base_tcp`` as an :class:`IKResult`, its errors measured by FK
-    of the URDF model (which the DH geometry of :func:`analytic_ik` matches to about 1e-12 m on the UR3)."""
-    dp, dr = pose_errors(robot.fk(q, "tcp"), T_base_tcp)
+    of the URDF model (which the DH geometry of :func:`analytic_ik` matches to about 1e-12 m on the UR3): the NumPy
+    FK of its chain (:meth:`~ur3hanoi.robot.Ur3Model.fk_matrix`, Pinocchio's FK to rounding), so a table that needs
+    no refinement needs no Pinocchio."""
+    dp, dr = pose_errors(robot.fk_matrix(q, "tcp"), T_base_tcp)
     return IKResult(q=q, position_error=dp, orientation_error=dr, iterations=0, solver=CLOSED_FORM)
 
 
-def closest_reach(robot: Ur3Model, T_base_tcp: pin.SE3, q_seed: FloatArray) -> IKResult:
+def closest_reach(robot: Ur3Model, T_base_tcp: pin.SE3 | FloatArray, q_seed: FloatArray) -> IKResult:
     """Heavily damped least squares from ``q_seed``: the pose closest to an unreachable target, for its residual.
 
     Damping keeps the steps bounded at the workspace boundary, where the Jacobian is singular.
@@ -305,7 +338,7 @@ def closest_reach(robot: Ur3Model, T_base_tcp: pin.SE3, q_seed: FloatArray) -> I
     return PinocchioIK(robot, max_iterations=300, damping=1e-3).solve(T_base_tcp, q_seed)
 
 
-def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3, q_home: FloatArray, label: str = "pose",
+def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3 | FloatArray, q_home: FloatArray, label: str = "pose",
                     home_branch: Branch | None = None) -> IKResult:
     """Solve ``T_base_tcp`` on the branch of ``q_home``, each joint the 2pi-equivalent nearest home.
 
@@ -322,11 +355,14 @@ def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3, q_home: FloatArray, l
     q_home = np.asarray(q_home, dtype=float)
     if home_branch is None:
         home_branch = branch_of(q_home, robot.dh)
-    T_base_tool0 = T_base_tcp * robot.T_tcp_tool0
+    H_base_tcp = as_matrix(T_base_tcp)
+    T_base_tool0 = se3_mul(H_base_tcp, robot.H_tcp_tool0)  # Pinocchio's SE3 product, to the last bit
 
     def where() -> str:
-        xyz = np.round(T_base_tcp.translation, 4).tolist()
-        rpy = np.round(np.degrees(pin.rpy.matrixToRpy(T_base_tcp.rotation)), 2).tolist()
+        import pinocchio as pin
+
+        xyz = np.round(H_base_tcp[:3, 3], 4).tolist()
+        rpy = np.round(np.degrees(pin.rpy.matrixToRpy(H_base_tcp[:3, :3])), 2).tolist()
         return f"{label}: target xyz {xyz} m rpy {rpy} deg in base"
 
     branches = analytic_ik(T_base_tool0, only=home_branch, dh=robot.dh)
@@ -366,3 +402,29 @@ def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3, q_home: FloatArray, l
     return res
 
 
+def solve_table_on_branch(solver: IKSolver, targets: Sequence[pin.SE3 | FloatArray], q_home: FloatArray,
+                          labels: Sequence[str], home_branch: Branch | None = None) -> list[IKResult]:
+    """:func:`solve_on_branch` of every pose of ``targets`` (``T_base_tcp``), the same results, with the closed
+    form's FK check done for all poses in one NumPy pass (a table is 18 poses; most need no refinement). A pose
+    without a closed-form solution on home's branch, or whose residual exceeds the tolerances, goes through
+    :func:`solve_on_branch` (its refinement, or its error naming ``labels[i]``)."""
+    robot = solver.robot
+    q_home = np.asarray(q_home, dtype=float)
+    if home_branch is None:
+        home_branch = branch_of(q_home, robot.dh)
+    H = [as_matrix(T) for T in targets]
+    seeds: list[FloatArray | None] = []
+    for H_base_tcp in H:
+        branches = analytic_ik(se3_mul(H_base_tcp, robot.H_tcp_tool0), only=home_branch, dh=robot.dh)
+        seeds.append(nearest_equivalent(branches[home_branch], q_home, robot.limits) if branches else None)
+    ok = [i for i, q in enumerate(seeds) if q is not None]
+    reached = robot.fk_matrix(np.array([seeds[i] for i in ok]).reshape(-1, 6), "tcp")
+    results: dict[int, IKResult] = {}
+    for i, H_reached in zip(ok, reached, strict=True):
+        dp, dr = pose_errors(H_reached, H[i])
+        res = IKResult(q=seeds[i], position_error=dp, orientation_error=dr, iterations=0,  # type: ignore[arg-type]
+                       solver=CLOSED_FORM)
+        if res.converged:
+            results[i] = res
+    return [results[i] if i in results else solve_on_branch(solver, targets[i], q_home, labels[i], home_branch)
+            for i in range(len(H))]

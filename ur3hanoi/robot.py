@@ -15,19 +15,24 @@ drives both; only the root frame differs.
 
 from __future__ import annotations
 
-import importlib.metadata
 import math
 import re
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, cached_property
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
+from ur3hanoi.robot_chain import UrdfChain, parse_chain, rigid_inverse, se3_act_inv
 from ur3hanoi.robot_registry import CB3_CONTROL_PERIOD_S, UR3, DHParameters, RobotDescription
+
+if TYPE_CHECKING:
+    import pinocchio as pin
+
+    T_BASELINK_BASE: pin.SE3
 
 JOINT_NAMES: tuple[str, ...] = (
     "shoulder_pan_joint",
@@ -44,8 +49,26 @@ DH_D: tuple[float, ...] = (0.1519, 0.0, 0.0, 0.11235, 0.08535, 0.0819)
 DH_A: tuple[float, ...] = (0.0, -0.24365, -0.21325, 0.0, 0.0, 0.0)
 DH_ALPHA: tuple[float, ...] = (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0)
 
-# Controller `base` seen from URDF `base_link`: a half turn about z.
-T_BASELINK_BASE = pin.SE3(pin.utils.rotate("z", math.pi), np.zeros(3))
+# Controller `base` seen from URDF `base_link`: a half turn about z (as a 4x4 matrix; T_BASELINK_BASE is the same
+# as a pin.SE3, made on first use so that importing this module does not import Pinocchio).
+H_BASELINK_BASE: FloatArray = np.eye(4)
+H_BASELINK_BASE[:2, :2] = [[math.cos(math.pi), -math.sin(math.pi)], [math.sin(math.pi), math.cos(math.pi)]]
+H_BASE_BASELINK: FloatArray = rigid_inverse(H_BASELINK_BASE)
+
+
+@cache
+def _se3(name: str) -> pin.SE3:
+    import pinocchio as pin
+
+    T = pin.SE3(pin.utils.rotate("z", math.pi), np.zeros(3))
+    return T if name == "T_BASELINK_BASE" else T.inverse()
+
+
+def __getattr__(name: str) -> object:
+    """``T_BASELINK_BASE``: :data:`H_BASELINK_BASE` as a ``pin.SE3`` (Pinocchio imported on first use)."""
+    if name == "T_BASELINK_BASE":
+        return _se3(name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 # The lab's home: radians([120, -90, 90, -90, -90, 0]).
 Q_HOME_LAB: tuple[float, ...] = tuple(math.radians(d) for d in (120.0, -90.0, 90.0, -90.0, -90.0, 0.0))
@@ -132,8 +155,25 @@ class ToolOffset:
 FLANGE_FRAMES: tuple[str, ...] = ("ee_link", "tool0")
 
 
+@cache
 def _erd_share_dir() -> Path:
-    """`cmeel.prefix/share` of the installed example-robot-data, found without importing its loaders."""
+    """`cmeel.prefix/share` of the installed example-robot-data, found without importing its loaders.
+
+    The folder of its ``example_robot_data-*.dist-info`` on ``sys.path`` (what ``importlib.metadata`` finds, without
+    the cost of importing it); ``importlib.metadata`` when there is no such folder (another kind of install).
+    """
+    import os
+    import sys
+
+    for entry in sys.path:
+        try:
+            names = os.listdir(entry or ".")
+        except OSError:
+            continue
+        if any(n.startswith("example_robot_data-") and n.endswith(".dist-info") for n in names):
+            return Path(entry or ".").resolve() / "cmeel.prefix" / "share"
+    import importlib.metadata
+
     try:
         dist = importlib.metadata.distribution("example-robot-data")
     except importlib.metadata.PackageNotFoundError as exc:
@@ -237,23 +277,23 @@ def dh_fk(q: FloatArray, dh: DHParameters | None = None) -> FloatArray:
 _EXPECTED_LENGTHS = {"d1": 0.1519, "a2": 0.24365, "a3": 0.21325, "d4": 0.11235, "d5": 0.08535, "d6": 0.0819}
 
 
-def _link_lengths(model: pin.Model) -> dict[str, float]:
+def _link_lengths(chain: UrdfChain) -> dict[str, float]:
     def p(name: str) -> FloatArray:
-        return model.jointPlacements[model.getJointId(name)].translation
+        return chain.joint_placements[chain.joint_names.index(name)][:3, 3]
 
-    fid = model.getFrameId("tool0")
     return {
         "d1": float(p("shoulder_pan_joint")[2]),
         "a2": float(p("elbow_joint")[2]),
         "a3": float(p("wrist_1_joint")[2]),
         "d4": float(p("shoulder_lift_joint")[1] + p("elbow_joint")[1] + p("wrist_2_joint")[1]),
         "d5": float(p("wrist_3_joint")[2]),
-        "d6": float(model.frames[fid].placement.translation[1]),
+        "d6": float(chain.frames["tool0"][1][1, 3]),
     }
 
 
 class Ur3Model:
-    """Pinocchio model of the UR3 with an optional ``tcp`` frame.
+    """The UR3 with an optional ``tcp`` frame: NumPy FK of its URDF chain (:mod:`ur3hanoi.robot_chain`) and the
+    Pinocchio model (built on first use of :attr:`model`, :attr:`data`, :attr:`frame_ids`, :meth:`fk`).
 
     FK results are expressed in the controller ``base`` frame (see the module docstring).
 
@@ -269,11 +309,10 @@ class Ur3Model:
         self.description = robot
         self.dh: DHParameters = robot.dh
         self.urdf = urdf_text(self.tool, absolute_meshes=True, robot=robot)
-        self.model: pin.Model = pin.buildModelFromXML(self.urdf)
-        self.data: pin.Data = self.model.createData()
-        if tuple(self.model.names[1:]) != JOINT_NAMES:
-            raise Ur3HanoiError(f"URDF joints {tuple(self.model.names[1:])} are not the UR3's {JOINT_NAMES}")
-        lengths = _link_lengths(self.model)
+        self.chain = parse_chain(self.urdf)
+        if self.chain.joint_names != JOINT_NAMES:
+            raise Ur3HanoiError(f"URDF joints {self.chain.joint_names} are not the UR3's {JOINT_NAMES}")
+        lengths = _link_lengths(self.chain)
         d, a = robot.dh.d, robot.dh.a
         expected_lengths = _EXPECTED_LENGTHS if robot is UR3 else {
             "d1": d[0], "a2": -a[1], "a3": -a[2], "d4": d[3], "d5": d[4], "d6": d[5]}
@@ -283,30 +322,80 @@ class Ur3Model:
                     f"{robot.urdf_file or robot.name}: link length {key} = {lengths[key]} m, expected the "
                     f"{robot.title}'s {expected} m (is this a UR5/UR10 URDF?)"
                 )
-        self.frame_ids = {name: self.model.getFrameId(name) for name in ("base", "base_link", "tool0", "tcp")}
-        self.frame_ids["ee_link"] = self.model.getFrameId("ee_link")
-        self._T_base_baselink = T_BASELINK_BASE.inverse()
+        for name in ("base", "base_link", "tool0", "tcp", "ee_link"):
+            if name not in self.chain.frames:
+                raise Ur3HanoiError(f"{robot.urdf_file or robot.name}: the URDF has no {name!r} link")
         # The flange seen from the TCP: constant, used by every IK solve to turn a TCP target into a flange one.
-        self.T_tcp_tool0: pin.SE3 = self.T_flange_tcp("tool0").inverse()
+        f = self.chain.frames
+        if f["tcp"][0] != f["tool0"][0]:
+            raise Ur3HanoiError(f"{robot.urdf_file or robot.name}: the tcp and tool0 links are not fixed to the same "
+                                "joint")
+        self.H_tcp_tool0: FloatArray = rigid_inverse(se3_act_inv(f["tool0"][1], f["tcp"][1]))
+
+    @cached_property
+    def model(self) -> pin.Model:
+        """Pinocchio's model of the URDF (with the ``tcp`` frame), built on first use."""
+        import pinocchio as pin
+
+        model = pin.buildModelFromXML(self.urdf)
+        if tuple(model.names[1:]) != JOINT_NAMES:
+            raise Ur3HanoiError(f"URDF joints {tuple(model.names[1:])} are not the UR3's {JOINT_NAMES}")
+        return model
+
+    @cached_property
+    def data(self) -> pin.Data:
+        """Pinocchio's data of :attr:`model` (one per model: :meth:`fk` is not thread-safe)."""
+        return self.model.createData()
+
+    @cached_property
+    def frame_ids(self) -> dict[str, int]:
+        """Pinocchio frame ids of ``base``, ``base_link``, ``tool0``, ``tcp`` and ``ee_link``."""
+        return {name: self.model.getFrameId(name) for name in ("base", "base_link", "tool0", "tcp", "ee_link")}
+
+    @cached_property
+    def T_tcp_tool0(self) -> pin.SE3:
+        """:attr:`H_tcp_tool0` as a ``pin.SE3``."""
+        import pinocchio as pin
+
+        return pin.SE3(self.H_tcp_tool0)
 
     @property
     def nq(self) -> int:
-        return int(self.model.nq)
+        return N_JOINTS
 
     def fk(self, q: FloatArray, frame: str = "tcp") -> pin.SE3:
-        """Pose of ``frame`` in the controller ``base`` frame at joint angles ``q`` [rad]."""
+        """Pose of ``frame`` in the controller ``base`` frame at joint angles ``q`` [rad] (Pinocchio's FK)."""
+        import pinocchio as pin
+
         try:
             fid = self.frame_ids[frame]
         except KeyError:
             raise Ur3HanoiError(f"frame {frame!r} is unknown: expected one of {sorted(self.frame_ids)}") from None
         pin.framesForwardKinematics(self.model, self.data, np.asarray(q, dtype=float))
-        return self._T_base_baselink * self.data.oMf[fid]
+        return _se3("T_BASE_BASELINK") * self.data.oMf[fid]
+
+    def fk_matrix(self, q: FloatArray, frame: str = "tcp") -> FloatArray:
+        """4x4 pose of ``frame`` in the controller ``base`` frame at ``q`` [rad] ((N, 4, 4) for ``q`` of shape
+        (N, 6)): the NumPy FK of the URDF chain, equal to :meth:`fk` to rounding (no Pinocchio)."""
+        if frame not in ("base", "base_link", "tool0", "tcp", "ee_link"):
+            raise Ur3HanoiError(f"frame {frame!r} is unknown: expected one of "
+                                f"{sorted(('base', 'base_link', 'tool0', 'tcp', 'ee_link'))}")
+        return H_BASE_BASELINK @ self.chain.fk(q, frame)
 
     def frame_jacobian_local(self, q: FloatArray, frame: str = "tcp") -> FloatArray:
         """6x6 Jacobian of ``frame`` in its own (LOCAL) frame; frame-independent of the root rotation."""
+        import pinocchio as pin
+
         return pin.computeFrameJacobian(
             self.model, self.data, np.asarray(q, dtype=float), self.frame_ids[frame], pin.LOCAL
         )
+
+    def H_flange_tcp(self, flange: str = "tool0") -> FloatArray:
+        """:meth:`T_flange_tcp` as a 4x4 matrix, from the URDF chain (no Pinocchio)."""
+        if flange not in FLANGE_FRAMES:
+            raise Ur3HanoiError(f"flange frame {flange!r} is invalid: expected one of {FLANGE_FRAMES}")
+        f = self.chain.frames
+        return se3_act_inv(f[flange][1], f["tcp"][1])
 
     def T_flange_tcp(self, flange: str = "tool0") -> pin.SE3:
         """The constant TCP pose in a flange frame (``tool0`` or ``ee_link``)."""
@@ -330,6 +419,8 @@ __all__ = [
     "DH_ALPHA",
     "DH_D",
     "FLANGE_FRAMES",
+    "H_BASELINK_BASE",
+    "H_BASE_BASELINK",
     "JOINT_NAMES",
     "N_JOINTS",
     "Q_HOME_LAB",

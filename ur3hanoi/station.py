@@ -36,10 +36,9 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
-import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import MISSING, CalibrationError, printable
@@ -49,6 +48,7 @@ from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
 from ur3hanoi.resources import station_file, station_names
 from ur3hanoi.robot import FLANGE_FRAMES, N_JOINTS, JointLimits, ToolOffset
+from ur3hanoi.robot_chain import rpy_matrix
 from ur3hanoi.robot_registry import DEFAULT_ROBOT, ROBOTS, RobotDescription
 from ur3hanoi.suction_profile import (
     AIN_RANGE_V,
@@ -60,6 +60,9 @@ from ur3hanoi.suction_profile import (
     SuctionProfile,
     with_levels,
 )
+
+if TYPE_CHECKING:
+    import pinocchio as pin
 
 Vec3 = tuple[float, float, float]
 Layout = Literal["flat", "stacked"]
@@ -117,7 +120,17 @@ class Station:
     @property
     def T_world_base(self) -> pin.SE3:
         """Pose of the controller ``base`` frame in world."""
+        import pinocchio as pin
+
         return pin.SE3(pin.rpy.rpyToMatrix(*self.base_rpy), np.array(self.base_xyz, dtype=float))
+
+    @property
+    def H_world_base(self) -> FloatArray:
+        """:attr:`T_world_base` as a 4x4 matrix (NumPy only, the same bits)."""
+        H = np.eye(4)
+        H[:3, :3] = rpy_matrix(*self.base_rpy)
+        H[:3, 3] = self.base_xyz
+        return H
 
     @property
     def q_home_array(self) -> FloatArray:

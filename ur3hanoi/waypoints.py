@@ -15,9 +15,10 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import TableError, printable
-from ur3hanoi.grid import POSE_NAMES, T_base_tcp, T_world_tcp
-from ur3hanoi.ik import IKResult, IKSolver, branch_of, make_solver, pose_errors, solve_on_branch
+from ur3hanoi.grid import POSE_NAMES, H_world_tcp, T_world_tcp
+from ur3hanoi.ik import IKResult, IKSolver, branch_of, make_solver, pose_errors, solve_table_on_branch
 from ur3hanoi.robot import N_JOINTS, load_ur3
+from ur3hanoi.robot_chain import se3_act_inv
 from ur3hanoi.station import Station
 
 
@@ -55,16 +56,12 @@ def generate_table(station: Station, solver: str | IKSolver = "pinocchio") -> Ta
     """
     if isinstance(solver, str):
         solver = make_solver(solver, load_ur3(station.tool, station.limits, station.robot))
-    q = np.empty((station.n_towers, station.n_heights, 2, N_JOINTS))
-    results = []
-    home_branch = branch_of(station.q_home_array, station.robot.dh)
-    for t in range(station.n_towers):
-        for h in range(station.n_heights):
-            for k in (0, 1):
-                res = solve_on_branch(solver, T_base_tcp(station, t, h, k), station.q_home_array,
-                                      label=f"{station.source}: {pose_label(t, h, k)}", home_branch=home_branch)
-                q[t, h, k] = res.q
-                results.append(res)
+    slots = [(t, h, k) for t in range(station.n_towers) for h in range(station.n_heights) for k in (0, 1)]
+    H_world_base = station.H_world_base
+    results = solve_table_on_branch(solver, [se3_act_inv(H_world_base, H_world_tcp(station, *s)) for s in slots],
+                                    station.q_home_array, [f"{station.source}: {pose_label(*s)}" for s in slots],
+                                    branch_of(station.q_home_array, station.robot.dh))
+    q = np.array([r.q for r in results]).reshape(station.n_towers, station.n_heights, 2, N_JOINTS)
     return Table(station=station, q=q, results=tuple(results), solver=solver.name)
 
 

@@ -62,11 +62,12 @@ def add(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import json
 
-    from ur3hanoi.io.atomic import atomic_write, check_output
     from ur3hanoi.plan import PlanConfig, plan_json_dict, plan_solve, trajectory_csv
     from ur3hanoi.station import load_station
 
     inputs = [input_file(calibration_ref(args.calibration))]
+    if args.csv or args.html:
+        from ur3hanoi.io.atomic import atomic_write, check_output  # the writer, only when the plan writes a file
     if args.csv:
         check_output(args.csv, inputs=inputs)  # fail before planning, not after
     if args.html:

@@ -23,7 +23,8 @@ Package map (dependencies flow downward only; each module is one concept):
 - ``checks/``: what a plan must satisfy. :mod:`~ur3hanoi.plan.checks.limits` joint limits;
   :mod:`~ur3hanoi.plan.checks.vertical` the 2 mm vertical line; :mod:`~ur3hanoi.plan.checks.suction` what the
   suction holds while carrying; :mod:`~ur3hanoi.plan.checks.collision` the clearance rules and
-  :func:`check_collisions`; :mod:`~ur3hanoi.plan.checks.clearance` the planner's per-segment clearance check.
+  :func:`check_collisions`; :mod:`~ur3hanoi.plan.checks.clearance` the planner's per-segment clearance check;
+  :mod:`~ur3hanoi.plan.checks.stored` its result in the user's cache.
 - ``baseline/``: :mod:`~ur3hanoi.plan.baseline.lab_program` the lab's own program on the same moves (movej per
   waypoint, its waits); :mod:`~ur3hanoi.plan.baseline.stop_and_go` the stop-and-go references between the same
   waypoints.
@@ -54,9 +55,15 @@ also by forward kinematics at 1 kHz where it is built), and the clearances by th
 Speed (see ``bench/REPORT.md``): the motion is measured against the honest stop-and-go baseline (joint-space
 Ruckig from rest to rest between the same waypoints, same limits and dwells: ``Plan.stop_and_go_duration_s``);
 the exact-vertical stop-and-go the project used to compare with is ``Plan.exact_vertical_stop_and_go_duration_s``.
+
+Names of :mod:`ur3hanoi.labfile.visits` and :mod:`~ur3hanoi.plan.table_plan` are loaded on first use: a plan of a
+station does not read lab files, and importing ``ur3hanoi.labfile`` (its reader and writer) is a tenth of a cold
+``ur3hanoi plan``'s imports.
 """
 
-from ur3hanoi.labfile.visits import entries_visited, entry_label, missing_entries
+from importlib import import_module
+from typing import TYPE_CHECKING
+
 from ur3hanoi.plan.checks.collision import CollisionScene, check_collisions
 from ur3hanoi.plan.checks.limits import check_limits
 from ur3hanoi.plan.checks.vertical import check_vertical
@@ -66,7 +73,6 @@ from ur3hanoi.plan.motion.ruckig import OfflineRuckig, RuckigSolution, control_s
 from ur3hanoi.plan.motion.sampling import sample
 from ur3hanoi.plan.motion.vertical import VerticalPath
 from ur3hanoi.plan.planner import plan_moves, plan_solve
-from ur3hanoi.plan.table_plan import check_table_shape, plan_table
 from ur3hanoi.plan.types import (
     DEFAULT_VIA_ACCELS,
     DEFAULT_VIA_SPEEDS,
@@ -81,6 +87,24 @@ from ur3hanoi.plan.types import (
     Trajectory,
 )
 from ur3hanoi.plan.waypoints import Waypoints, build_waypoints
+
+if TYPE_CHECKING:
+    from ur3hanoi.labfile.visits import entries_visited, entry_label, missing_entries
+    from ur3hanoi.plan.table_plan import check_table_shape, plan_table
+
+_LAZY = {"entries_visited": "ur3hanoi.labfile.visits", "entry_label": "ur3hanoi.labfile.visits",
+         "missing_entries": "ur3hanoi.labfile.visits", "check_table_shape": "ur3hanoi.plan.table_plan",
+         "plan_table": "ur3hanoi.plan.table_plan"}
+
+
+def __getattr__(name: str) -> object:
+    """The names of :data:`_LAZY`, imported on first use."""
+    if name in _LAZY:
+        value = getattr(import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "DEFAULT_VIA_ACCELS",

@@ -16,9 +16,9 @@ from ur3hanoi.station import Station
 @lru_cache(maxsize=32)
 def _tcp_frames(station: Station) -> tuple[tuple[float, float, float], FloatArray, FloatArray]:
     """The suction point in the flange frame (tool0) [m], and the world rotation and translation of ``base``."""
-    t = load_ur3(station.tool, station.limits, station.robot).T_flange_tcp("tool0").translation
-    T_wb = station.T_world_base
-    return (float(t[0]), float(t[1]), float(t[2])), T_wb.rotation.copy(), T_wb.translation.copy()
+    t = load_ur3(station.tool, station.limits, station.robot).H_flange_tcp("tool0")[:3, 3]
+    H_wb = station.H_world_base
+    return (float(t[0]), float(t[1]), float(t[2])), H_wb[:3, :3].copy(), H_wb[:3, 3].copy()
 
 
 def tcp_positions_world(station: Station, q: FloatArray) -> FloatArray:

@@ -13,8 +13,8 @@ from collections.abc import Sequence
 from ur3hanoi.errors import PlanError
 from ur3hanoi.hanoi import Move, check_sequence, solve_hanoi
 from ur3hanoi.plan.baseline.stop_and_go import exact_vertical_motion_s, stop_and_go_motion_s
-from ur3hanoi.plan.checks.clearance import check_segments
 from ur3hanoi.plan.checks.limits import check_limits
+from ur3hanoi.plan.checks.stored import check_segments
 from ur3hanoi.plan.checks.suction import check_suction_hold
 from ur3hanoi.plan.checks.vertical import check_vertical
 from ur3hanoi.plan.motion.sampling import sample
@@ -58,7 +58,7 @@ def plan_moves(station: Station, moves: Sequence[Move], config: PlanConfig | Non
     timings["checks"] = time.perf_counter() - t0
     if config.check_collisions and moves:
         t0 = time.perf_counter()
-        violations += check_segments(segments, moves, station, n_blocks, start, config, limits)
+        violations += check_segments(segments, moves, station, n_blocks, start, config, limits, tr)
         timings["collision"] = time.perf_counter() - t0
     duration = segments[-1].t_end
     plan = Plan(station=station, moves=tuple(moves), trajectory=tr, stop_and_go_duration_s=stop_go, config=config,

@@ -14,18 +14,21 @@ import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
-import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.cache import collision_geometry
 from ur3hanoi.grid import R_world_tcp_down, block_center_world, table_z
 from ur3hanoi.hanoi import Move, stacks_before_moves
 from ur3hanoi.plan.types import DWELL_PHASES, VERTICAL_PHASES, KinematicLimits, Phase, PlanConfig, Trajectory
-from ur3hanoi.robot import N_JOINTS, T_BASELINK_BASE, load_ur3
+from ur3hanoi.robot import N_JOINTS, load_ur3
 from ur3hanoi.station import Station
+
+if TYPE_CHECKING:
+    import pinocchio as pin
 
 Slot = tuple[int, int]  # (tower, height), 0-based
 Pair = tuple[tuple[int, int], float]  # (geometry ids, required distance [m])
@@ -65,6 +68,9 @@ class CollisionScene:
 
     def __init__(self, station: Station, n_blocks: int) -> None:
         import coal
+        import pinocchio as pin
+
+        from ur3hanoi.robot import T_BASELINK_BASE
 
         self.station = station
         robot = load_ur3(station.tool, station.limits, station.robot)
@@ -141,9 +147,11 @@ class CollisionScene:
         """Put each resting block (block -> (tower, height)) at its slot; blocks not listed are parked far away."""
         for b, gid in enumerate(self.blocks):
             p = block_center_world(self.station, *slots[b]) if b in slots else np.array([100.0 + 10 * b, 100.0, 100.0])
-            self.gm.geometryObjects[gid].placement = self.T_baselink_world * pin.SE3(self._R_block, p)
+            self.gm.geometryObjects[gid].placement = self.T_baselink_world * _se3(self._R_block, p)
 
     def distances(self, q: FloatArray, pairs: Sequence[tuple[int, int]]) -> FloatArray:
+        import pinocchio as pin
+
         pin.updateGeometryPlacements(self.model, self.data, self.gm, self.gd, q)
         return np.array([pin.computeDistance(self.gm, self.gd, self.pairs[p]).min_distance for p in pairs])
 
@@ -155,6 +163,12 @@ class CollisionScene:
         if mover == "robot":
             return [g for g in self.robot_geoms if g != self.base_geom]
         return [self.cup] if mover == "cup" else [self.carried]
+
+
+def _se3(R: FloatArray, p: FloatArray) -> pin.SE3:
+    import pinocchio as pin
+
+    return pin.SE3(R, p)
 
 
 @lru_cache(maxsize=8)
@@ -260,6 +274,8 @@ def check_collisions(tr: Trajectory, moves: Sequence[Move], station: Station, n_
     # Fresh GeometryData: Pinocchio warm-starts GJK from each pair's previous query (enable_cached_gjk_guess), so
     # reusing it would let the distances depend, in the last bits, on the plans checked before. Block placements
     # need no reset: every run below places all blocks before its first query.
+    import pinocchio as pin
+
     scene.gd = pin.GeometryData(scene.gm)
     stacks = stacks_before_moves(moves, n_blocks, start, station.n_towers)
     out: list[str] = []

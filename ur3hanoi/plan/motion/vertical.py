@@ -18,7 +18,6 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
@@ -113,6 +112,8 @@ def tangent_down(robot: Ur3Model, R_world_base: FloatArray, q: FloatArray) -> Fl
 def line_ik(robot: Ur3Model, station: Station, tower: int, height: int) -> Callable[[float, FloatArray], FloatArray]:
     """``ik(s, q_ref)``: closed-form IK [rad] of the suction point ``s`` [m] below the above pose of (tower, height),
     on home's branch, nearest ``q_ref``."""
+    import pinocchio as pin
+
     T_above = T_base_tcp(station, tower, height, ABOVE)
     R_base_world = station.T_world_base.rotation.T
     branch = branch_of(station.q_home_array, robot.dh)
