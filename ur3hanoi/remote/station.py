@@ -125,8 +125,9 @@ class StationCore:
 
     A binding sets :attr:`TOPIC_LOG` (the log-line prefix of each kind of message), may override
     :meth:`_command` (how a command message becomes a :meth:`StationDriver.submit
-    <ur3hanoi.remote.driver.StationDriver.submit>`), :meth:`_emit` (where log lines go) and the report hooks, and
-    calls :meth:`loop` with its receive and publish steps inside :meth:`signals`.
+    <ur3hanoi.remote.driver.StationDriver.submit>`), :meth:`_emit` (where log lines go) and
+    :meth:`_report_transport` (its report section), and calls :meth:`loop` with its receive and publish steps
+    inside :meth:`signals` and :meth:`rendering` (then :meth:`close_sink` before the final report).
 
     Args:
         options: what to run.
@@ -299,10 +300,6 @@ class StationCore:
         """The binding's sections after ``suction`` (e.g. the master, the DDS domain)."""
         return {}
 
-    def _report_extra(self) -> dict[str, Any]:
-        """The binding's sections after ``frames``, before ``reports_written``."""
-        return {}
-
     def report(self) -> dict[str, Any]:
         """The JSON report (see the module docstring); numbering from 1."""
         w, st = self.world, self.station
@@ -335,7 +332,6 @@ class StationCore:
                 "blocks": [b.as_dict() for b in w.blocks()],
             },
             "frames": self._frames_report(),
-            **self._report_extra(),
             "reports_written": self.reports_written + 1,
         }
 
