@@ -9,6 +9,8 @@ Usage:
 - ``python tests/ros2_publisher.py --flood HZ SECONDS JSON``: send the field dicts in turn at HZ for SECONDS on an
   absolute schedule while reading ``ur3e/position``; prints one JSON line: commands sent, positions received
   during the flood, and the largest gap between received positions [s].
+- ``python tests/ros2_publisher.py --int TOPIC VALUE...``: publish each VALUE as ``std_msgs/Int32`` on TOPIC
+  (``ur3hanoi/spawn``, ``ur3hanoi/remove_block``) once the station subscribes it, 100 ms apart, then wait 0.5 s.
 """
 
 from __future__ import annotations
@@ -20,12 +22,12 @@ import time
 from typing import Any
 
 from ur3hanoi.ros2.dds import Ros2Node
-from ur3hanoi.ros2.msgs import CommandUR3e, PositionUR3e
+from ur3hanoi.ros2.msgs import CommandUR3e, Int32, PositionUR3e
 
 
-def _connect() -> tuple[Ros2Node, Any, Any]:
+def _connect(topic: str = "ur3e/command", msg_type: type = CommandUR3e) -> tuple[Ros2Node, Any, Any]:
     node = Ros2Node("ur3hanoi_test_publisher")
-    pub = node.publisher("ur3e/command", CommandUR3e)
+    pub = node.publisher(topic, msg_type)
     positions = node.subscription("ur3e/position", PositionUR3e)
     node.announce()
     deadline = time.monotonic() + 15.0
@@ -35,7 +37,7 @@ def _connect() -> tuple[Ros2Node, Any, Any]:
         if seen and pub.get_matched_subscriptions():
             return node, pub, positions
         time.sleep(0.02)
-    raise SystemExit("no ur3e/command subscriber or ur3e/position within 15 s")
+    raise SystemExit(f"no {topic} subscriber or ur3e/position within 15 s")
 
 
 def _command(fields: dict[str, Any]) -> CommandUR3e:
@@ -47,6 +49,16 @@ def send(items: list[dict[str, Any]]) -> int:
     node, pub, _ = _connect()
     for fields in items:
         pub.write(_command(fields))
+        time.sleep(0.1)
+    time.sleep(0.5)
+    node.close()
+    return 0
+
+
+def send_int(topic: str, values: list[int]) -> int:
+    node, pub, _ = _connect(topic, Int32)
+    for value in values:
+        pub.write(Int32(data=value))
         time.sleep(0.1)
     time.sleep(0.5)
     node.close()
@@ -83,4 +95,6 @@ def flood(rate_hz: float, seconds: float, items: list[dict[str, Any]]) -> int:
 if __name__ == "__main__":
     if sys.argv[1] == "--flood":
         sys.exit(flood(float(sys.argv[2]), float(sys.argv[3]), json.loads(sys.argv[4])))
+    if sys.argv[1] == "--int":
+        sys.exit(send_int(sys.argv[2], [int(v) for v in sys.argv[3:]]))
     sys.exit(send(json.loads(sys.argv[1])))

@@ -1,15 +1,19 @@
 """The transport-neutral station (ur3hanoi.remote.station) through both bindings, in process (no ROS, no DDS):
-a command flood is counted in full while the report, the records and the log lines stay bounded."""
+a command flood is counted in full while the report, the records and the log lines stay bounded; the render sink
+(--frames/--video) writes what the report counts."""
 
 from __future__ import annotations
 
+import gc
 import json
 from collections.abc import Callable
+from pathlib import Path
 from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
-from ur3hanoi.remote.station import LAG_BINS_MS, LoopTiming, StationCore
+from ur3hanoi.remote.station import LAG_BINS_MS, CoreOptions, LoopTiming, StationCore
 from ur3hanoi.ros.station import RosStation, StationOptions
 from ur3hanoi.ros2.station import Ros2Station, Ros2StationOptions
 
@@ -63,3 +67,46 @@ def test_loop_timing_counts_lag_into_its_histogram() -> None:
     hist = d["lag_histogram_ms"]
     assert list(hist) == [f"<{b:g}" for b in LAG_BINS_MS] + [f">={LAG_BINS_MS[-1]:g}"]
     assert hist["<1"] == 2 and hist["<2"] == 1 and hist["<16"] == 1 and hist[">=32"] == 1
+
+
+@pytest.mark.parametrize("kind", ["frames", "video"])
+def test_the_render_sink_writes_what_the_report_counts(kind: str, tmp_path: Path,
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    """StationCore without a transport, 2 s of real time with one move of joint 1 and ``frames`` or ``video``: the
+    rendering process writes as many frames as the report says it rendered (the rest dropped, not waited for),
+    the pictures are not blank and show the arm moving."""
+    import imageio_ffmpeg
+    from PIL import Image
+
+    monkeypatch.setenv("MUJOCO_GL", "egl")
+    out = tmp_path / ("run.mp4" if kind == "video" else "frames")
+    node = StationCore(CoreOptions(duration_s=2.0, **{kind: out}), out=lambda _s: None, report_out=lambda _s: None)
+    q = [float(x) for x in node.world.q]
+    node.on_command(SimpleNamespace(destination=[q[0] + 0.8, *q[1:]], v=3.0, a=6.0, io_0=False))
+    try:
+        with node.rendering():
+            node.loop("ready", lambda: None, lambda: None)
+            assert not out.exists()  # written only when the sink closes (ur3hanoi.io.atomic)
+    finally:
+        gc.unfreeze()
+    frames = node.report()["frames"]
+    assert frames["rendered"] > 0 and frames["dropped"] >= 0, frames
+    if kind == "video":
+        assert imageio_ffmpeg.count_frames_and_secs(str(out))[0] == frames["rendered"]
+        reader = imageio_ffmpeg.read_frames(str(out))
+        meta = next(reader)
+        w, h = meta["size"]
+        images = [np.frombuffer(f, dtype=np.uint8).reshape(h, w, 3).astype(np.float64) for f in reader]
+    else:
+        pngs = sorted(out.glob("frame_*.png"))
+        assert len(pngs) == frames["rendered"]
+        images = []
+        for p in pngs:
+            with Image.open(p) as im:
+                images.append(np.asarray(im.convert("RGB"), dtype=np.float64))
+    assert len(images) == frames["rendered"]
+    colours = [np.unique(im.astype(np.int64) @ np.array([65536, 256, 1])).size for im in images]
+    assert min(im.std() for im in images) > 5.0 and min(colours) > 50, colours
+    if len(images) > 1:
+        assert max(float(np.abs(im - images[0]).max()) for im in images) > 50.0  # the arm moved
+    assert node.report()["frames"] == frames  # closed: the counts are final

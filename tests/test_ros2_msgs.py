@@ -1,7 +1,7 @@
 """ur3hanoi.ros2.msgs against an independent implementation: rosbags serializes the course's ``.msg`` text to CDR and
 computes RIHS01 hashes. The station's bytes must equal rosbags' for the three course messages (edge cases
-included), for std_msgs/Bool and for rmw_dds_common's ParticipantEntitiesInfo (Jazzy's 16-byte Gid); the type
-hashes are pinned. No DDS participant is created here."""
+included), for std_msgs/Bool and std_msgs/Int32 and for rmw_dds_common's ParticipantEntitiesInfo (Jazzy's 16-byte
+Gid); the type hashes are pinned. No DDS participant is created here."""
 
 from __future__ import annotations
 
@@ -22,6 +22,7 @@ from ur3hanoi.ros2.msgs import (
     CommandUR3e,
     Gid,
     GripperInput,
+    Int32,
     NodeEntitiesInfo,
     ParticipantEntitiesInfo,
     PositionUR3e,
@@ -32,6 +33,8 @@ PINNED = {  # ../shared/lab/ros2-interface.md
     "ur3e_mrc_msgs/msg/CommandUR3e": "RIHS01_2f0dfb5da40b6bad863b59c393cc69c48d7de0c7b9a221e6887242a70a1b9974",
     "ur3e_mrc_msgs/msg/PositionUR3e": "RIHS01_07cb4e678e1673c909c6b9844394c3bd7347c40b95867ecf6a1f10ae424bd745",
     "ur3e_mrc_msgs/msg/GripperInput": "RIHS01_af06f2466c87ef322c22b736462e05003f4dde7867f2bf44ffc965f5ef568841",
+    # std_msgs (ur3hanoi/spawn, ur3hanoi/remove_block); the same value is pinned by independent ROS 2 libraries
+    "std_msgs/msg/Int32": "RIHS01_b6578ded3c58c626cfe8d1a6fb6e04f706f97e9f03d2727c9ff4e74b1cef0deb",
 }
 
 
@@ -85,6 +88,15 @@ def test_position_and_gripper_bytes_equal_rosbags(position: list[float], ready: 
         "ur3e_mrc_msgs/msg/PositionUR3e", position=position, is_ready=ready)
     assert GripperInput(dig_in=dig, a_in0=a0, a_in1=a1).serialize() == _oracle(
         "ur3e_mrc_msgs/msg/GripperInput", dig_in=dig, a_in0=a0, a_in1=a1)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.integers(-2**31, 2**31 - 1))
+def test_int32_bytes_equal_rosbags(data: int) -> None:
+    ours = Int32(data=data).serialize()
+    assert ours == bytes(TS.serialize_cdr(TS.types["std_msgs/msg/Int32"](data=data), "std_msgs/msg/Int32"))
+    assert Int32.deserialize(ours).data == data
+    assert Int32.__idl_typename__ == "std_msgs::msg::dds_::Int32_"
 
 
 def test_bool_and_discovery_info_bytes_equal_rosbags() -> None:

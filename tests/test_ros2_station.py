@@ -280,3 +280,64 @@ kill -INT $ST; wait $ST; echo "station exit $?" >&2
     assert len(r["executed"]) <= 100 and len(r["rejected"]) <= 100
     assert report.stat().st_size < 100_000
     assert _left_running(report) == []
+
+
+# ------------------------------------------------------------------------------- spawn, remove_block, frames
+
+
+def _png_pixels(path: Path) -> np.ndarray:
+    from PIL import Image
+
+    with Image.open(path) as im:
+        return np.asarray(im.convert("RGB"), dtype=np.float64)
+
+
+@pytest.mark.dds
+@requires_netns
+def test_remove_block_and_spawn_over_dds_with_frames_rendered(tmp_path: Path) -> None:
+    """One block, ``--frames``: ur3hanoi/remove_block 1 takes it away, so ros2-solve finds no block at the grasp
+    (gripper_input) and halts; ur3hanoi/spawn 1 puts it back, and ros2-solve then moves it to tower 3. Invalid
+    numbers are refused with a log line. The rendering process wrote non-blank PNGs of the moving arm, counted in
+    the report."""
+    report, frames = tmp_path / "report.json", tmp_path / "frames"
+    solve = "$UR3HANOI ros2-solve --start 1 --end 3 --blocks 1 --v 4 --a 4 --json"
+    script = f"""
+MUJOCO_GL=egl $UR3HANOI ros2-station --timing honest --blocks 1 --frames {frames} --report {report} \\
+  > {tmp_path}/st.out 2> {tmp_path}/st.err &
+ST=$!
+wait_ready {tmp_path}/st.out || exit 90
+{PUBLISHER} --int ur3hanoi/remove_block 0 1 || exit 91
+{solve} > {tmp_path}/halt.json; echo "halt exit $?" >&2
+kill -USR1 $ST; sleep 0.5; cp {report} {tmp_path}/snap.json
+{PUBLISHER} --int ur3hanoi/spawn 7 1 || exit 92
+{solve} > {tmp_path}/solve.json; echo "solve exit $?" >&2
+kill -INT $ST; wait $ST; echo "station exit $?" >&2
+"""
+    result = in_netns(script, 300.0, REPO)
+    err = (tmp_path / "st.err").read_text()
+    assert result.returncode == 0, result.stdout + result.stderr + err
+    assert "halt exit 3" in result.stderr and "solve exit 0" in result.stderr and "station exit 0" in result.stderr
+    halt = json.loads((tmp_path / "halt.json").read_text().strip().splitlines()[-1])
+    assert halt["status"] == "halted" and "tower 1 height 1" in halt["error"], halt
+    solved = json.loads((tmp_path / "solve.json").read_text().strip().splitlines()[-1])
+    assert solved["status"] == "solved" and solved["moves"] == 1
+    snap, r = json.loads((tmp_path / "snap.json").read_text()), json.loads(report.read_text())
+    assert [f["kind"] for f in snap["faults"]] == ["removed"] and snap["faults"][0]["block"] == 1
+    assert [b["tower"] for b in snap["final"]["blocks"]] == [None]  # taken away: off the grid
+    assert [s["tower"] for s in r["spawns"]] == [1, 1]  # at start, then by the topic
+    assert [(b["block"], b["tower"], b["height"]) for b in r["final"]["blocks"]] == [(1, 3, 1)]
+    assert r["final"]["at_home"] and not r["final"]["suction_on"]
+    lines = _log_lines(err)
+    assert "[ERROR] ur3hanoi/remove_block: block 0 is invalid: expected 1..1" in lines, lines
+    assert any(x.startswith("[WARN] ur3hanoi/remove_block: ") and "block 1 removed" in x for x in lines), lines
+    assert any(x.startswith("[ERROR] ur3hanoi/spawn: ") and "tower 7 is invalid: expected 1..3" in x
+               for x in lines), lines
+    assert any(x.startswith("[INFO] ur3hanoi/spawn: ") and "respawned on tower 1" in x for x in lines), lines
+    # Rendering: every frame the report counts is a PNG, none blank, and the arm moves between them.
+    pngs = sorted(frames.glob("frame_*.png"))
+    assert r["frames"]["rendered"] == len(pngs) > 0 and r["frames"]["dropped"] >= 0, r["frames"]
+    images = [_png_pixels(p) for p in pngs]
+    colours = [np.unique(im.astype(np.int64) @ np.array([65536, 256, 1])).size for im in images]
+    assert min(im.std() for im in images) > 5.0 and min(colours) > 50, colours  # not blank: a rendered scene
+    assert max(float(np.abs(im - images[0]).max()) for im in images) > 50.0
+    assert _left_running(report) == []

@@ -73,3 +73,28 @@ def test_tower_ranges_are_the_stations(command, station, option, capsys, monkeyp
     assert main([command, option, "0", other, "2"]) == 2
     expected = f"ur3hanoi: error: {option} 0 is invalid: expected a tower 1..3 ({station} has 3 towers)"
     assert error_line(capsys) == expected
+
+
+@pytest.mark.parametrize("command", ["ros-station", "ros2-station"])
+@pytest.mark.parametrize(("option", "target", "expected"), [
+    ("--video", "{tmp}", "is a directory"),
+    ("--video", "{tmp}/run.avi2", "extension"),
+    ("--frames", "{tmp}/missing/frames", "missing does not exist"),
+    ("--report", "/proc/report.json", "the directory /proc does not accept new files"),
+])
+def test_station_outputs_are_refused_before_the_station_starts(command, option, target, expected, tmp_path,
+                                                              monkeypatch, capsys):
+    """Both stations check --video, --frames and --report the same way (ur3hanoi.io.atomic), in one line, before
+    anything runs (no master, no DDS participant, no rendering process) and without creating a file."""
+    from ur3hanoi.ros.station import RosStation
+    from ur3hanoi.ros2.station import Ros2Station
+
+    started: list[str] = []
+    for cls in (RosStation, Ros2Station):
+        monkeypatch.setattr(cls, "run", lambda self: started.append(type(self).__name__) or {})
+    target = target.format(tmp=tmp_path)
+    assert main([command, "--duration", "0.5", option, target]) == 2
+    line = error_line(capsys)
+    assert line.startswith("ur3hanoi: error: cannot write ") and target in line and expected in line, line
+    assert started == []
+    assert sorted(p.name for p in tmp_path.iterdir()) == []

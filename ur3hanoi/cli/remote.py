@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -66,10 +67,30 @@ def add_station_options(p: argparse.ArgumentParser, default_calibration: str, an
 
 
 def add_station_outputs(p: argparse.ArgumentParser) -> None:
-    """``--report``, ``--duration``, ``--suction-profile``."""
+    """``--report``, ``--duration``, ``--suction-profile``, ``--video``/``--frames`` (one of them)."""
     p.add_argument("--report", metavar="FILE", help="write the JSON report to FILE (default: stdout)")
     p.add_argument("--duration", type=option(DURATION), metavar="S", help="stop by itself after S seconds")
     add_suction_profile_option(p)
+    out = p.add_mutually_exclusive_group()
+    out.add_argument("--video", metavar="FILE.mp4", help="render an MP4 offscreen (headless: MUJOCO_GL=egl)")
+    out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR")
+
+
+def check_station_outputs(args: argparse.Namespace, default_calibration: str) -> Path | None:
+    """Refuse a ``--report``, ``--video`` or ``--frames`` that cannot be written (:mod:`ur3hanoi.io.atomic`), before
+    any work; returns the report file (None: standard output, also for ``--report -``). Sets ``MUJOCO_GL=egl``
+    for rendering on a machine without a display."""
+    if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
+        os.environ["MUJOCO_GL"] = "egl"  # headless offscreen rendering (read when the GL context is created)
+    from ur3hanoi.cli.common import check_render_outputs, input_file
+    from ur3hanoi.io.atomic import check_output
+
+    inputs = [input_file(args.calibration or default_calibration)]
+    report = None if args.report in (None, "-") else Path(args.report)
+    if report is not None:
+        check_output(report, inputs=inputs)
+    check_render_outputs(args.video, args.frames, inputs)
+    return report
 
 
 def station_options(args: argparse.Namespace, default_calibration: str, report: Path | None) -> dict[str, Any]:
@@ -78,7 +99,8 @@ def station_options(args: argparse.Namespace, default_calibration: str, report: 
             "n_blocks": args.blocks, "removed": None if args.remove_block is None else args.remove_block - 1,
             "drop_on_grasp": None if args.drop_on_grasp is None else args.drop_on_grasp - 1, "seed": args.seed,
             "rate_hz": args.rate, "report": report, "duration_s": args.duration,
-            "suction_profile": args.suction_profile}
+            "suction_profile": args.suction_profile, "frames": Path(args.frames) if args.frames else None,
+            "video": Path(args.video) if args.video else None}
 
 
 def stopped_line(command: str, report: dict[str, Any], extra: str = "") -> str:

@@ -60,28 +60,15 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
                         "127.0.0.1: this machine only. Give this machine's lab-network address to open them to "
                         "other machines (a master on another machine needs it)")
     remote.add_station_outputs(p)
-    out = p.add_mutually_exclusive_group()
-    out.add_argument("--video", metavar="FILE.mp4", help="render an MP4 offscreen (headless: MUJOCO_GL=egl)")
-    out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR")
     p.set_defaults(func=_run_station)
 
 
 def _run_station(args: argparse.Namespace) -> int:
-    if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
-        os.environ["MUJOCO_GL"] = "egl"  # headless offscreen rendering (read when the GL context is created)
-    from ur3hanoi.cli.common import check_render_outputs, input_file
-    from ur3hanoi.io.atomic import check_output
+    report_file = remote.check_station_outputs(args, DEFAULT_CALIBRATION)  # before any work
     from ur3hanoi.ros.station import RosStation, StationOptions
 
-    inputs = [input_file(args.calibration or DEFAULT_CALIBRATION)]
-    report_file = None if args.report in (None, "-") else Path(args.report)  # "-": standard output
-    if report_file is not None:
-        check_output(report_file, inputs=inputs)  # before any work
-    check_render_outputs(args.video, args.frames, inputs)
-    options = StationOptions(
-        **remote.station_options(args, DEFAULT_CALIBRATION, report_file),
-        frames=Path(args.frames) if args.frames else None, video=Path(args.video) if args.video else None,
-        master_uri=args.master, host=args.host)
+    options = StationOptions(**remote.station_options(args, DEFAULT_CALIBRATION, report_file),
+                             master_uri=args.master, host=args.host)
     node = RosStation(options)
     # Standard output carries only the JSON report: whatever else writes to file descriptor 1 (rospy's info
     # handler, C libraries) goes to stderr while the node runs.

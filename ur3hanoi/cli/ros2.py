@@ -7,7 +7,6 @@ exit code 2; a suction fault exits with 3. Heavy imports (MuJoCo, Cyclone DDS) h
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from ur3hanoi.cli import remote
 
@@ -23,7 +22,8 @@ _STATION_DESCRIPTION = (
     "The ROS 2 course bridge (UMD ENME480 ur3e_mrc_msgs) over Cyclone DDS, no ROS installation: "
     "subscribes ur3e/command (CommandUR3e), publishes ur3e/position (PositionUR3e), "
     "ur3e/gripper_input (GripperInput: the suction model's dig_in/a_in0) and gripper/grasping "
-    "(Bool), default QoS, node ur3hanoi_station. Bridge behaviour by default: destinations of "
+    "(Bool), default QoS, node ur3hanoi_station. Topics ur3hanoi/spawn (std_msgs/Int32 tower) and "
+    "ur3hanoi/remove_block (block, 1 = bottom) respawn and remove blocks. Bridge behaviour by default: destinations of "
     "length != 6 dropped with a log line, every move 2 s (v and a ignored), is_ready always true, "
     "joint values in the bridge's convention (controller = course + [pi/2, 0, 0, -pi/2, 0, 0]). "
     "Loopback only unless --network. On SIGINT/SIGTERM (SIGUSR1: without stopping) writes a JSON "
@@ -73,14 +73,14 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_station(args: argparse.Namespace) -> int:
+    report_file = remote.check_station_outputs(args, DEFAULT_ROS2_CALIBRATION)  # before any work
     from ur3hanoi.ros2.station import Ros2Station, Ros2StationOptions
 
-    report_file = Path(args.report) if args.report else None
     options = Ros2StationOptions(**remote.station_options(args, DEFAULT_ROS2_CALIBRATION, report_file),
                                  timing=args.timing, convention=args.convention, network=args.network,
                                  domain_id=args.domain_id)
     report = Ros2Station(options).run()
-    if args.report:
+    if report_file is not None:
         print(remote.stopped_line("ros2-station", report, f"report {args.report}"), flush=True)
     return 0
 

@@ -14,6 +14,7 @@ the package imports nothing heavy (MuJoCo only with :mod:`~ur3hanoi.remote.world
 - :mod:`~ur3hanoi.remote.lograte`: log lines a flood cannot multiply (one per topic and second, with counts).
 - :mod:`~ur3hanoi.remote.station`: the station node's scaffolding (options, bounded inbox, real-time loop,
   report, signals), :class:`~ur3hanoi.remote.station.StationCore`.
+- :mod:`~ur3hanoi.remote.render`: ``--frames``/``--video`` of a station in a separate low-priority process.
 - :mod:`~ur3hanoi.remote.client`: the client's move-and-wait and suction feedback over three topics,
   :class:`~ur3hanoi.remote.client.TopicArm`.
 - :mod:`~ur3hanoi.remote.solve`: the lab program's solve with suction checks and halt (:func:`run_lab_solve`).

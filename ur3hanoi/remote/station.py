@@ -17,10 +17,16 @@ topic messages are logged through :class:`~ur3hanoi.remote.lograte.RateLimitedLo
 second, with counts); the records are bounded (:mod:`ur3hanoi.remote.driver`, world events), so memory and the
 report do not grow with the number of commands.
 
+Rendering (``frames``/``video`` options, ``--frames``/``--video``): :meth:`StationCore.rendering` starts a
+separate low-priority process (:class:`ur3hanoi.remote.render.FrameProcess`); :meth:`StationCore.loop` offers it the
+joint state once per frame period of world time (dropped while it is busy, so the loop keeps real time), and the
+report's ``frames`` says how many were rendered and dropped.
+
 The JSON report (:meth:`StationCore.report`): commands executed (with duration, settle time and rest error),
 refused, suction events, faults, spawns, final block positions (tower/height, or none = off-grid), loop timing,
-plus the binding's own sections. It is written on SIGINT/SIGTERM and at the end of ``duration_s``, and on SIGUSR1
-without stopping: to ``options.report`` (atomically) or, without it, to ``report_out``.
+rendered frames, plus the binding's own sections. It is written on SIGINT/SIGTERM and at the end of
+``duration_s``, and on SIGUSR1 without stopping: to ``options.report`` (atomically) or, without it, to
+``report_out``.
 """
 
 from __future__ import annotations
@@ -67,6 +73,8 @@ class CoreOptions:
         duration_s: stop by itself after this wall time [s], or None (until SIGINT/SIGTERM).
         suction_profile: a named suction feedback profile (``lab_sim``, ``real``) replacing the calibration's,
             or None (the calibration's ``suction`` section).
+        frames, video: offscreen rendering into a PNG folder or an MP4 file (at most one), as in ``ur3hanoi
+            solve``; None: no rendering.
     """
 
     calibration: str = "lab_sim"
@@ -79,6 +87,8 @@ class CoreOptions:
     report: Path | None = None
     duration_s: float | None = None
     suction_profile: str | None = None
+    frames: Path | None = None
+    video: Path | None = None
 
 
 class LoopTiming:
@@ -115,8 +125,9 @@ class StationCore:
 
     A binding sets :attr:`TOPIC_LOG` (the log-line prefix of each kind of message), may override
     :meth:`_command` (how a command message becomes a :meth:`StationDriver.submit
-    <ur3hanoi.remote.driver.StationDriver.submit>`), :meth:`_emit` (where log lines go) and the report hooks, and
-    calls :meth:`loop` with its receive and publish steps inside :meth:`signals`.
+    <ur3hanoi.remote.driver.StationDriver.submit>`), :meth:`_emit` (where log lines go) and
+    :meth:`_report_transport` (its report section), and calls :meth:`loop` with its receive and publish steps
+    inside :meth:`signals` and :meth:`rendering` (then :meth:`close_sink` before the final report).
 
     Args:
         options: what to run.
@@ -161,6 +172,11 @@ class StationCore:
         self._dump = False
         self._wall0 = 0.0
         self._wall_end: float | None = None
+        if opts.frames is not None and opts.video is not None:
+            raise RosError("give at most one of frames (a PNG folder) and video (an MP4 file)")
+        self._sink: Any = None  # the FrameProcess while rendering
+        self._frames: dict[str, int] | None = None  # its final counts once closed
+        self._next_frame_s = 0.0  # world time of the next frame [s]
 
     # ---------------------------------------------------------------------------------------------- callbacks
     def _offer(self, kind: str, payload: Any) -> None:
@@ -234,6 +250,46 @@ class StationCore:
                     self.log.log(self.TOPIC_LOG[kind], "error", f"block {payload!r} is invalid: expected 1..{n}")
         self.log.flush()
 
+    # --------------------------------------------------------------------------------------------- rendering
+    def open_sink(self) -> None:
+        """Start the rendering process when ``frames`` or ``video`` is set (a binding calls it before its transport
+        starts threads, so a slow start cannot delay messages; :meth:`rendering` does both)."""
+        opts = self.options
+        if self._sink is not None or (opts.frames is None and opts.video is None):
+            return
+        from ur3hanoi.remote.render import FrameProcess
+
+        self._sink = FrameProcess(opts.calibration, self.world.n_blocks, opts.frames, opts.video)
+        self._next_frame_s = self.world.time
+
+    def close_sink(self) -> None:
+        """Finish the PNG folder or video and stop the rendering process (the report then has its final counts);
+        nothing when not rendering or already closed."""
+        if self._sink is not None and self._frames is None:
+            self._frames = self._sink.close()
+
+    @contextmanager
+    def rendering(self) -> Iterator[None]:
+        """:meth:`open_sink` now, :meth:`close_sink` at the end (also when the block raises)."""
+        self.open_sink()
+        try:
+            yield
+        finally:
+            self.close_sink()
+
+    def offer_frame(self) -> None:
+        """Send the joint state to the rendering process when a frame period of world time has passed."""
+        sink = self._sink
+        if sink is None or self._frames is not None or self.world.time + 1e-9 < self._next_frame_s:
+            return
+        sink.offer(self.world.scene.data.qpos)
+        self._next_frame_s += 1.0 / sink.fps
+
+    def _frames_report(self) -> dict[str, int] | None:
+        if self._frames is not None:
+            return self._frames
+        return None if self._sink is None else {"rendered": self._sink.rendered, "dropped": self._sink.dropped}
+
     def cycle(self) -> None:
         """One control period without a transport: handle the inbox, then one driver and world step."""
         self._drain()
@@ -242,10 +298,6 @@ class StationCore:
     # ------------------------------------------------------------------------------------------------ report
     def _report_transport(self) -> dict[str, Any]:
         """The binding's sections after ``suction`` (e.g. the master, the DDS domain)."""
-        return {}
-
-    def _report_extra(self) -> dict[str, Any]:
-        """The binding's sections before ``reports_written`` (e.g. rendered frames)."""
         return {}
 
     def report(self) -> dict[str, Any]:
@@ -279,7 +331,7 @@ class StationCore:
                 "at_home": w.at_home(),
                 "blocks": [b.as_dict() for b in w.blocks()],
             },
-            **self._report_extra(),
+            "frames": self._frames_report(),
             "reports_written": self.reports_written + 1,
         }
 
@@ -317,8 +369,8 @@ class StationCore:
     def loop(self, ready_line: str, receive: Callable[[], None], publish: Callable[[], None],
              running: Callable[[], bool] = lambda: True) -> None:
         """Write ``ready_line``, then every control period: ``receive`` (take what arrived), :meth:`cycle`,
-        ``publish`` (the feedback); a SIGUSR1 report; until stopped, ``running()`` is false or ``duration_s``
-        passed. Pending log summaries are written at the end."""
+        ``publish`` (the feedback), :meth:`offer_frame` (when rendering); a SIGUSR1 report; until stopped,
+        ``running()`` is false or ``duration_s`` passed. Pending log summaries are written at the end."""
         period = self.world.config.period_s
         self.out(ready_line)
         # Everything built so far lives as long as the node: keep the cyclic collector from scanning it in the loop.
@@ -332,6 +384,7 @@ class StationCore:
                 receive()
                 self.cycle()
                 publish()
+                self.offer_frame()
                 if self._dump:
                     self._dump = False
                     self.write_report()

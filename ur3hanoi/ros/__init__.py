@@ -8,7 +8,6 @@ Modules, one concept each (importing this package needs neither rospy nor MuJoCo
 - :mod:`~ur3hanoi.ros.master`: ``ROS_MASTER_URI``; find, start and stop a ``roscore`` (loopback by default).
 - :mod:`~ur3hanoi.ros.guard`: the process that keeps a started roscore from outliving the station (even SIGKILL).
 - :mod:`~ur3hanoi.ros.station`: the ``ros-station`` node (:class:`~ur3hanoi.remote.station.StationCore` on rospy).
-- :mod:`~ur3hanoi.ros.render`: ``--frames``/``--video`` in a separate low-priority process.
 - :mod:`~ur3hanoi.ros.client`: the rospy client (:class:`~ur3hanoi.ros.client.RosArm`, a
   :class:`~ur3hanoi.remote.client.TopicArm`).
 - :mod:`~ur3hanoi.ros.errors`: :class:`~ur3hanoi.ros.errors.RosUnavailableError` (ROS 1 not installed).

@@ -30,11 +30,12 @@ not used.
 Output: the ready line and every info line go to ``info`` (the CLI: stderr); standard output carries only the
 JSON report when there is no ``--report`` file.
 
-``--frames``/``--video`` render in a separate low-priority process (:mod:`ur3hanoi.ros.render`), which drops
-frames rather than stall the loop.
+``--frames``/``--video`` render in a separate low-priority process (:mod:`ur3hanoi.remote.render`, started by
+:meth:`~ur3hanoi.remote.station.StationCore.rendering`), which drops frames rather than stall the loop.
 
 The JSON report (:meth:`RosStation.report`): commands executed (with duration, settle time and rest error),
-refused, suction events, faults, final block positions (tower/height, or none = off-grid), loop timing. It is
+refused, suction events, faults, final block positions (tower/height, or none = off-grid), loop timing, rendered
+frames. It is
 written on SIGINT/SIGTERM and at the end of ``--duration``, and on SIGUSR1 without stopping: to ``--report FILE``
 (atomically) or, without it, to stdout.
 """
@@ -42,12 +43,10 @@ written on SIGINT/SIGTERM and at the end of ``--duration``, and on SIGUSR1 witho
 from __future__ import annotations
 
 import ipaddress
-import math
 import os
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, ClassVar
 
 from ur3hanoi.remote.errors import RosError
@@ -62,14 +61,11 @@ class StationOptions(CoreOptions):
     """What ``ur3hanoi ros-station`` runs: :class:`~ur3hanoi.remote.station.CoreOptions` and
 
     Attributes:
-        frames, video: offscreen rendering (PNG folder or MP4), as in ``ur3hanoi solve``.
         master_uri: ROS master (None: ``ROS_MASTER_URI``, else http://localhost:11311).
         host: address the station and the roscore it starts listen on and advertise (``ROS_IP``); the default
             127.0.0.1 keeps them on this machine.
     """
 
-    frames: Path | None = None
-    video: Path | None = None
     master_uri: str | None = None
     host: str = "127.0.0.1"
 
@@ -107,8 +103,6 @@ class RosStation(StationCore):
                            "listening on loopback only: give --host ADDR, this machine's address on the lab network")
         self.roscore_started = False
         self._rospy: Any = None
-        self._sink: Any = None
-        self._frames: dict[str, int] | None = None
 
     # ---------------------------------------------------------------------------------------------- callbacks
     def _on_spawn(self, msg: Any) -> None:
@@ -128,10 +122,6 @@ class RosStation(StationCore):
     def _report_transport(self) -> dict[str, Any]:
         return {"master_uri": self.master_uri, "roscore_started": self.roscore_started}
 
-    def _report_extra(self) -> dict[str, Any]:
-        return {"frames": self._frames if self._frames is not None else (
-            None if self._sink is None else {"rendered": self._sink.rendered, "dropped": self._sink.dropped})}
-
     # --------------------------------------------------------------------------------------------------- run
     def run(self) -> dict[str, Any]:
         """Start (or use) the master, run the node until SIGINT/SIGTERM or ``duration_s``; returns the report."""
@@ -146,56 +136,37 @@ class RosStation(StationCore):
         # interval a flood of messages can keep the control loop waiting most of an 8 ms period.
         switch = sys.getswitchinterval()
         sys.setswitchinterval(min(switch, 0.0005))
-        sink: Any = None
         try:
-            with self.signals():
-                sink = self._sink = self._open_sink()  # before rospy starts its threads
-                with RosCore(self.master_uri, host=self.options.host) as core:
-                    self.roscore_started = core.started
-                    # rospy reads these from the environment: the master, and the address to bind and advertise.
-                    env = listen_env(dict(os.environ, ROS_MASTER_URI=self.master_uri), self.options.host)
-                    os.environ.pop("ROS_HOSTNAME", None)
-                    os.environ.update(env)
-                    rospy.init_node("ur3hanoi_station", argv=[sys.argv[0]], disable_signals=True)
-                    pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
-                    pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
-                    rospy.Subscriber("/ur3/command", msgs.command, self.on_command, queue_size=100)
-                    rospy.Subscriber("/ur3hanoi/spawn", std_msgs.Int32, self._on_spawn, queue_size=10)
-                    rospy.Subscriber("/ur3hanoi/remove_block", std_msgs.Int32, self._on_remove, queue_size=10)
-                    try:
-                        self._run_loop(msgs, pub_pos, pub_grip, sink)
-                    finally:
-                        rospy.signal_shutdown("ur3hanoi ros-station stopped")
-                    if sink is not None:
-                        self._frames = sink.close()
-                    report = self.write_report()
+            # The rendering process starts before rospy's threads.
+            with self.signals(), self.rendering(), RosCore(self.master_uri, host=self.options.host) as core:
+                self.roscore_started = core.started
+                # rospy reads these from the environment: the master, and the address to bind and advertise.
+                env = listen_env(dict(os.environ, ROS_MASTER_URI=self.master_uri), self.options.host)
+                os.environ.pop("ROS_HOSTNAME", None)
+                os.environ.update(env)
+                rospy.init_node("ur3hanoi_station", argv=[sys.argv[0]], disable_signals=True)
+                pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
+                pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
+                rospy.Subscriber("/ur3/command", msgs.command, self.on_command, queue_size=100)
+                rospy.Subscriber("/ur3hanoi/spawn", std_msgs.Int32, self._on_spawn, queue_size=10)
+                rospy.Subscriber("/ur3hanoi/remove_block", std_msgs.Int32, self._on_remove, queue_size=10)
+                try:
+                    self._run_loop(msgs, pub_pos, pub_grip)
+                finally:
+                    rospy.signal_shutdown("ur3hanoi ros-station stopped")
+                self.close_sink()  # the report has the final frame counts
+                report = self.write_report()
         finally:
-            if sink is not None:
-                sink.close()
             sys.setswitchinterval(switch)
         return report
 
-    def _open_sink(self) -> Any:
-        opts = self.options
-        if opts.frames is None and opts.video is None:
-            return None
-        from ur3hanoi.ros.render import FrameProcess
-
-        return FrameProcess(opts.calibration, self.world.n_blocks, opts.frames, opts.video)
-
-    def _run_loop(self, msgs: Any, pub_pos: Any, pub_grip: Any, sink: Any) -> None:
+    def _run_loop(self, msgs: Any, pub_pos: Any, pub_grip: Any) -> None:
         w, opts = self.world, self.options
-        frame_dt = 1.0 / sink.fps if sink is not None else math.inf
-        next_frame = 0.0
 
         def publish() -> None:
-            nonlocal next_frame
             fb = w.feedback()
             pub_pos.publish(msgs.position(position=[float(x) for x in w.q], isReady=self.driver.ready))
             pub_grip.publish(msgs.gripper_input(DIGIN=fb.digin, AIN0=fb.ain0, AIN1=0.0))
-            if sink is not None and w.time + 1e-9 >= next_frame:
-                sink.offer(w.scene.data.qpos)
-                next_frame += frame_dt
 
         st = self.station
         spawned = w.n_blocks - len(w.removed)  # --remove-block leaves one out

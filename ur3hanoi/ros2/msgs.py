@@ -30,6 +30,7 @@ TYPE_HASHES: dict[str, str] = {
     "ur3e_mrc_msgs/msg/PositionUR3e": "RIHS01_07cb4e678e1673c909c6b9844394c3bd7347c40b95867ecf6a1f10ae424bd745",
     "ur3e_mrc_msgs/msg/GripperInput": "RIHS01_af06f2466c87ef322c22b736462e05003f4dde7867f2bf44ffc965f5ef568841",
     "std_msgs/msg/Bool": "RIHS01_feb91e995ff9ebd09c0cb3d2aed18b11077585839fb5db80193b62d74528f6c9",
+    "std_msgs/msg/Int32": "RIHS01_b6578ded3c58c626cfe8d1a6fb6e04f706f97e9f03d2727c9ff4e74b1cef0deb",
 }
 """RIHS01 type hashes (identical for the Humble, Jazzy and Kilted message stores; pinned by the tests)."""
 
@@ -75,6 +76,14 @@ class Bool(IdlStruct, typename="std_msgs::msg::dds_::Bool_"):  # type: ignore[ca
 
 @dataclass
 @final
+class Int32(IdlStruct, typename="std_msgs::msg::dds_::Int32_"):  # type: ignore[call-arg]
+    """``std_msgs/msg/Int32`` (``ur3hanoi/spawn``: a tower, ``ur3hanoi/remove_block``: a block, numbered from 1)."""
+
+    data: int32 = 0
+
+
+@dataclass
+@final
 class Gid(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):  # type: ignore[call-arg]
     """An endpoint's global id: its 16-byte DDS GUID (Jazzy and later)."""
 
@@ -104,7 +113,8 @@ class ParticipantEntitiesInfo(IdlStruct, typename="rmw_dds_common::msg::dds_::Pa
 
 ROS_TYPES: dict[type, str] = {CommandUR3e: "ur3e_mrc_msgs/msg/CommandUR3e",
                               PositionUR3e: "ur3e_mrc_msgs/msg/PositionUR3e",
-                              GripperInput: "ur3e_mrc_msgs/msg/GripperInput", Bool: "std_msgs/msg/Bool"}
+                              GripperInput: "ur3e_mrc_msgs/msg/GripperInput", Bool: "std_msgs/msg/Bool",
+                              Int32: "std_msgs/msg/Int32"}
 """The ROS 2 name of each message type the station speaks."""
 
 
@@ -113,5 +123,5 @@ def dds_topic(ros_topic: str) -> str:
     return "rt/" + ros_topic.lstrip("/")
 
 
-__all__ = ["MSG_TEXT", "ROS_TYPES", "TYPE_HASHES", "Bool", "CommandUR3e", "Gid", "GripperInput", "NodeEntitiesInfo",
-           "ParticipantEntitiesInfo", "PositionUR3e", "dds_topic"]
+__all__ = ["MSG_TEXT", "ROS_TYPES", "TYPE_HASHES", "Bool", "CommandUR3e", "Gid", "GripperInput", "Int32",
+           "NodeEntitiesInfo", "ParticipantEntitiesInfo", "PositionUR3e", "dds_topic"]

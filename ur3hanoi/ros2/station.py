@@ -10,6 +10,9 @@ Topics (``../shared/lab/ros2-interface.md``), every endpoint with ROS 2's defaul
 - publishes ``ur3e/position`` (``PositionUR3e``, same convention), ``ur3e/gripper_input`` (``GripperInput``:
   ``dig_in``/``a_in0`` from the suction model at the station's suction profile, ``a_in1`` = 0: what the course
   simulator lacks) and ``gripper/grasping`` (``std_msgs/Bool``: a block is held), every control period.
+- subscribes ``ur3hanoi/spawn`` (``std_msgs/Int32``, tower 1..3: respawn every block there, like
+  ``lab2_spawn.py``) and ``ur3hanoi/remove_block`` (``std_msgs/Int32``, block 1..n, 1 = bottom: take it away; a
+  held block is dropped), as ``ros-station`` does; an invalid number is refused with a log line.
 
 Timing: ``bridge`` (default) is the course bridge's: ``v`` and ``a`` ignored, every move one trajectory point
 2.0 s away (executed as a synchronised triangular profile lasting 2.0 s, longer only when the UR3e's speed
@@ -19,10 +22,13 @@ command as the UR controller's ``movej`` at the message's ``v``/``a`` (capped at
 
 The world, command checks, motion, suction, the real-time loop, the bounded inbox, rate-limited log lines and
 the report are the transport-neutral station's (:class:`ur3hanoi.remote.station.StationCore`), shared with
-``ros-station``; only the transport (:mod:`ur3hanoi.ros2.dds`) differs: the loop takes at most 50 commands a
-cycle from the DDS reader (whose history is itself bounded by the QoS depth). Refusals are logged at most once
+``ros-station``; only the transport (:mod:`ur3hanoi.ros2.dds`) differs: the loop takes at most 50 messages a
+cycle from each DDS reader (whose history is itself bounded by the QoS depth). Refusals are logged at most once
 a second per topic, with counts. The JSON report (SIGINT/SIGTERM, ``duration_s``; SIGUSR1 without stopping)
 has ``ros-station``'s sections plus ``transport``.
+
+``--frames``/``--video`` render in a separate low-priority process that drops frames rather than stall the loop
+(:meth:`~ur3hanoi.remote.station.StationCore.rendering`, as ``ros-station``); the report's ``frames`` counts them.
 """
 
 from __future__ import annotations
@@ -47,12 +53,14 @@ BRIDGE_MOVE_S = 2.0
 """The course bridge's ``time_from_start`` of every move [s]."""
 TIMINGS: tuple[str, ...] = ("bridge", "honest")
 TAKE_PER_CYCLE = 50
-"""Commands taken from the DDS reader per control cycle: a flood is drained over several cycles."""
+"""Messages taken from each DDS reader per control cycle: a flood is drained over several cycles."""
 
 TOPIC_COMMAND = "ur3e/command"
 TOPIC_POSITION = "ur3e/position"
 TOPIC_GRIPPER = "ur3e/gripper_input"
 TOPIC_GRASPING = "gripper/grasping"
+TOPIC_SPAWN = "ur3hanoi/spawn"
+TOPIC_REMOVE = "ur3hanoi/remove_block"
 
 
 @dataclass(frozen=True)
@@ -97,7 +105,7 @@ class Ros2Station(StationCore):
     options: Ros2StationOptions
 
     TOPIC_LOG: ClassVar[dict[str, str]] = {"command": f"{TOPIC_COMMAND} dropped, the arm does not move",
-                                           "spawn": "spawn", "remove": "remove_block"}
+                                           "spawn": TOPIC_SPAWN, "remove": TOPIC_REMOVE}
 
     def __init__(self, options: Ros2StationOptions, out: Callable[[str], None] | None = None,
                  log: Callable[[str], None] | None = None) -> None:
@@ -158,9 +166,9 @@ class Ros2Station(StationCore):
     def run(self) -> dict[str, Any]:
         """Create the node, run until SIGINT/SIGTERM or ``duration_s``; returns the final report."""
         from ur3hanoi.ros2.dds import Ros2Node
-        from ur3hanoi.ros2.msgs import Bool, CommandUR3e, GripperInput, PositionUR3e
+        from ur3hanoi.ros2.msgs import Bool, CommandUR3e, GripperInput, Int32, PositionUR3e
 
-        with self.signals():
+        with self.signals(), self.rendering():  # the rendering process starts before the DDS threads
             try:
                 node = Ros2Node(NODE_NAME, self.domain_id, self.options.network)
             except Exception as exc:  # the DDS library's own errors (bad interface, no free participant index)
@@ -168,6 +176,7 @@ class Ros2Station(StationCore):
                     from None
             try:
                 commands = node.subscription(TOPIC_COMMAND, CommandUR3e)
+                spawns, removals = node.subscription(TOPIC_SPAWN, Int32), node.subscription(TOPIC_REMOVE, Int32)
                 pub_pos, pub_grip, pub_grasp = (node.publisher(TOPIC_POSITION, PositionUR3e),
                                                 node.publisher(TOPIC_GRIPPER, GripperInput),
                                                 node.publisher(TOPIC_GRASPING, Bool))
@@ -177,6 +186,12 @@ class Ros2Station(StationCore):
                     for msg in commands.take(N=TAKE_PER_CYCLE):
                         if hasattr(msg, "destination"):  # not an invalid sample (instance state only)
                             self.on_command(msg)
+                    for msg in spawns.take(N=TAKE_PER_CYCLE):
+                        if isinstance(msg, Int32):
+                            self.on_spawn(int(msg.data))
+                    for msg in removals.take(N=TAKE_PER_CYCLE):
+                        if isinstance(msg, Int32):
+                            self.on_remove(int(msg.data))
 
                 def publish() -> None:
                     fb = self.world.feedback()
@@ -187,6 +202,7 @@ class Ros2Station(StationCore):
                 self.loop(self._ready_line(), receive, publish)
             finally:
                 node.close()
+            self.close_sink()  # the report has the final frame counts
             return self.write_report()
 
     def _ready_line(self) -> str:

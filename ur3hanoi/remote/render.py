@@ -1,4 +1,5 @@
-"""Offscreen rendering for ``ros-station --frames/--video`` in a separate, low-priority process.
+"""Offscreen rendering for a station's ``--frames``/``--video`` (``ros-station``, ``ros2-station``) in a separate,
+low-priority process.
 
 Software EGL renders a 640x480 frame in about 100 ms and holds the interpreter while doing so: inside the control
 process it would stall the 8 ms loop (measured: 200 ms lags). So a child process (``spawn``, niced, Mesa's
@@ -63,7 +64,7 @@ class FrameProcess:
 
     def __init__(self, calibration: str, n_blocks: int, frames: Path | None, video: Path | None,
                  start_timeout_s: float = 120.0) -> None:
-        ctx = multiprocessing.get_context("spawn")  # never fork a process that runs rospy threads
+        ctx = multiprocessing.get_context("spawn")  # never fork a process that runs rospy's or DDS threads
         self._conn, child = ctx.Pipe()
         self._proc: Any = ctx.Process(target=_worker, args=(child, calibration, n_blocks, frames, video),
                                       daemon=True, name="ur3hanoi-render")
