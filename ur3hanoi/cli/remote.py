@@ -15,9 +15,8 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ur3hanoi.arrays import FloatArray
 from ur3hanoi.cli.common import add_suction_profile_option
 from ur3hanoi.cli.options import (
     BLOCKS,
@@ -35,6 +34,9 @@ from ur3hanoi.cli.options import (
     station_number,
 )
 from ur3hanoi.cli.solve import prompt_tower
+
+if TYPE_CHECKING:
+    from ur3hanoi.arrays import FloatArray
 
 # --------------------------------------------------------------------------------------------------- stations
 
