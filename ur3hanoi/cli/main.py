@@ -10,16 +10,21 @@ ur3hanoi <command> --help)`` and exits 2; anything unexpected prints ``ur3hanoi:
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 from collections.abc import Sequence
 from typing import NoReturn
 
 from ur3hanoi import __version__
-from ur3hanoi.cli import calibrate, check_table, exit_codes, plan, ros, ros2, solve, tables
+from ur3hanoi.cli import exit_codes
 from ur3hanoi.errors import Ur3HanoiError, printable
 
-_COMMANDS = (tables, check_table, calibrate, plan, solve, ros, ros2)
+COMMAND_MODULES: dict[str, str] = {
+    "tables": "tables", "check-table": "check_table", "calibrate": "calibrate", "plan": "plan", "solve": "solve",
+    "ros-station": "ros", "ros-solve": "ros", "ros-env": "ros", "ros2-station": "ros2", "ros2-solve": "ros2"}
+"""Each command's module in :mod:`ur3hanoi.cli`, in the order ``--help`` lists them. A run imports only its own
+command's module (the others' options cost start-up time and nothing else)."""
 ERROR_PREFIX = "ur3hanoi: error:"
 """What every error line on stderr starts with: bad input, bad options, a suction fault, an internal error."""
 _DEBUG_HELP = "on an internal error, show the Python traceback (for a bug report)"
@@ -37,14 +42,16 @@ def _one_line(text: object) -> str:
     return printable(" ".join(str(text).split()), 2000)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``ur3hanoi`` parser with its commands."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``ur3hanoi`` parser with every command, or only with ``command``'s module (see :data:`COMMAND_MODULES`;
+    an unknown name gives every command, so the error lists them all)."""
     parser = _Parser(prog="ur3hanoi", description="UR3 Tower of Hanoi lab toolkit.")
     parser.add_argument("--version", action="version", version=f"ur3hanoi {__version__}")
     parser.add_argument("--debug", action="store_true", help=_DEBUG_HELP)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for command in _COMMANDS:
-        command.add(sub)
+    modules = dict.fromkeys(COMMAND_MODULES.values())
+    for module in [COMMAND_MODULES[command]] if command in COMMAND_MODULES else modules:
+        importlib.import_module(f"ur3hanoi.cli.{module}").add(sub)
     for p in sub.choices.values():
         # Also accepted after the command; SUPPRESS keeps a --debug given before it.
         p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=_DEBUG_HELP)
@@ -75,10 +82,16 @@ def _exit_status(code: object) -> int:
     return code if isinstance(code, int) else exit_codes.BAD_INPUT
 
 
+def _command_of(argv: Sequence[str]) -> str | None:
+    """The command word of ``argv``: its first word that is not an option (the top-level options take no value)."""
+    return next((a for a in argv if not a.startswith("-")), None)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``ur3hanoi`` with ``argv`` (default ``sys.argv[1:]``); returns the exit code, never raises
     (except with ``--debug`` on an internal error)."""
-    parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(_command_of(argv))
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a usage error already printed
