@@ -74,6 +74,7 @@ class SimConfig:
     halt_speed: float = 0.5
     settle_s: float = 0.3
     knock_tolerance: float = 0.001
+    accel_feedforward: bool = True
 
 
 class FrameSink(Protocol):
@@ -150,6 +151,12 @@ class _Run:
         self.ctrl = self.servo.copy()
         self.ctrl[1:] = 0.5 * (self.servo[1:] + self.servo[:-1])
         d.ctrl[self.act_ids] = self.servo[0]
+        self.kp = kp
+        self.acc = None
+        if cfg.accel_feedforward:
+            self.acc = tr.qdd.copy()
+            self.acc[1:] = 0.5 * (tr.qdd[1:] + tr.qdd[:-1])
+        self._acc_vec, self._acc_res = np.zeros(m.nv), np.zeros(m.nv)
 
         self.cup = SuctionCup(scene, cfg.suction, seed=cfg.seed)
         self.events: list[FeedbackEvent] = []
@@ -182,10 +189,14 @@ class _Run:
     # ------------------------------------------------------------------------------------------ one control cycle
 
     def step_cycle(self, ctrl_k: FloatArray, split_after: int = 0,
-                   on_split: Callable[[], None] | None = None) -> GripperInput:
+                   on_split: Callable[[], None] | None = None, acc_k: FloatArray | None = None) -> GripperInput:
         """Hold ``ctrl_k`` for one control cycle (``on_split`` runs after ``split_after`` physics steps), render,
         pace, record the joints, and read ``gripper_input`` like the driver does every cycle."""
         m, d = self.m, self.d
+        if acc_k is not None:
+            self._acc_vec[self.scene.arm_dadr] = acc_k
+            mujoco.mj_mulM(m, d, self._acc_res, self._acc_vec)
+            ctrl_k = ctrl_k + self._acc_res[self.scene.arm_dadr] / self.kp
         d.ctrl[self.act_ids] = ctrl_k
         if split_after and on_split is not None:
             mujoco.mj_step(m, d, nstep=split_after)
@@ -232,9 +243,10 @@ class _Run:
                 cup.command(want)
             cup.update()
             if k == self.drop_k:
-                fb = self.step_cycle(self.ctrl[k], split_after=1, on_split=partial(self._inject_drop, mv))
+                fb = self.step_cycle(self.ctrl[k], split_after=1, on_split=partial(self._inject_drop, mv),
+                                     acc_k=None if self.acc is None else self.acc[k])
             else:
-                fb = self.step_cycle(self.ctrl[k])
+                fb = self.step_cycle(self.ctrl[k], acc_k=None if self.acc is None else self.acc[k])
             err = np.abs(self.joints[-1][1] - tr.q[k]).max()
             if err > self.max_err:
                 self.max_err = float(err)
