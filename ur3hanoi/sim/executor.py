@@ -64,6 +64,9 @@ class SimConfig:
         settle_s: time [s] simulated at rest after the last sample (blocks settle, the servo converges).
         knock_tolerance: after a halt, a block that rested when the fault was detected and has since moved
             farther than this [m] was knocked (e.g. by the dropped block) and is reported.
+        accel_feedforward: add the arm's own inertia times the reference acceleration, ``M(q) qdd_ref / kp``, to
+            the servo command (the UR controller moves on a model of its arm; velocity feed-forward alone left the
+            cup ~0.2 mm below the contact pose at the end of a place, pressing the block into the stack).
     """
 
     scene: SceneConfig = field(default_factory=SceneConfig)
@@ -151,8 +154,9 @@ class _Run:
         self.ctrl = self.servo.copy()
         self.ctrl[1:] = 0.5 * (self.servo[1:] + self.servo[:-1])
         d.ctrl[self.act_ids] = self.servo[0]
+        # Acceleration feed-forward per cycle (cycle means, like the command), or None (SimConfig.accel_feedforward).
         self.kp = kp
-        self.acc = None
+        self.acc: FloatArray | None = None
         if cfg.accel_feedforward:
             self.acc = tr.qdd.copy()
             self.acc[1:] = 0.5 * (tr.qdd[1:] + tr.qdd[:-1])
@@ -190,10 +194,11 @@ class _Run:
 
     def step_cycle(self, ctrl_k: FloatArray, split_after: int = 0,
                    on_split: Callable[[], None] | None = None, acc_k: FloatArray | None = None) -> GripperInput:
-        """Hold ``ctrl_k`` for one control cycle (``on_split`` runs after ``split_after`` physics steps), render,
-        pace, record the joints, and read ``gripper_input`` like the driver does every cycle."""
+        """Hold ``ctrl_k`` (plus the acceleration feed-forward of ``acc_k`` [rad/s^2], if given) for one control
+        cycle (``on_split`` runs after ``split_after`` physics steps), render, pace, record the joints, and read
+        ``gripper_input`` like the driver does every cycle."""
         m, d = self.m, self.d
-        if acc_k is not None:
+        if acc_k is not None:  # + M(q) qdd / kp: the joint-space inertia (armature included) at the current pose
             self._acc_vec[self.scene.arm_dadr] = acc_k
             mujoco.mj_mulM(m, d, self._acc_res, self._acc_vec)
             ctrl_k = ctrl_k + self._acc_res[self.scene.arm_dadr] / self.kp
@@ -418,10 +423,11 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
     """Execute ``plan`` in MuJoCo like the lab program: stream, operate suction, check feedback, halt on faults.
 
     Each control cycle (``1 / rate_hz`` [s], 4 physics steps at 125 Hz / 2 ms) commands the next trajectory
-    sample with velocity feed-forward, ``ctrl = q_ref + (kv/kp) * qd_ref``, so the servo force is
-    ``kp (q_ref - q) + kv (qd_ref - qd)``; then reads ``gripper_input``. A block must be held at the end of every
-    GRASP_DWELL and in every cycle of a carrying phase; otherwise the arm decelerates to rest (Ruckig, from the
-    reference state), the suction is turned off and the arm returns home (Ruckig), and
+    sample with velocity and acceleration feed-forward, ``ctrl = q_ref + (kv/kp) * qd_ref + M(q) qdd_ref / kp``,
+    so the servo force is ``kp (q_ref - q) + kv (qd_ref - qd) + M(q) qdd_ref``; then reads ``gripper_input``. A
+    block must be held at the end of every GRASP_DWELL and in every cycle of a carrying phase; otherwise the arm
+    decelerates to rest (Ruckig, from the reference state), the suction is turned off and the arm returns home
+    (Ruckig), and
     :class:`~ur3hanoi.errors.SuctionFaultError` is raised with the "halted" :class:`SimResult` as ``.result``.
 
     Args:
