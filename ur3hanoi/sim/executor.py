@@ -146,21 +146,23 @@ class _Run:
         kp = m.actuator_gainprm[self.act_ids, 0]
         kv = -m.actuator_biasprm[self.act_ids, 2]
         self.ff = kv / kp  # feed-forward velocity gain [s]
-        # The reference held during cycle k is the mean of the (linearly interpolated) servo command over that
-        # cycle, i.e. the average of samples k-1 and k: a zero-order hold of the end sample would lead the
-        # trajectory by a full cycle (measured: 0.67 deg error at the wrist instead of 0.13 deg). Precomputed: the
-        # loop is Python-bound.
+        # During cycle k the servo command moves linearly from sample k-1 to sample k, like a UR controller
+        # interpolating its servo targets: each physics step holds the mean of that line over the step. A zero-order
+        # hold of the end sample would lead the trajectory by a full cycle (measured: 0.67 deg error at the wrist
+        # instead of 0.13 deg); holding the cycle's mean lags it by half a cycle, which the stiff servo
+        # (ur3hanoi.sim.model.DRIVES) paid for with kp * v * 4 ms of torque: the wrists saturated at 12 N m
+        # returning home after a halt. Precomputed: the loop is Python-bound.
         self.servo = tr.q + tr.qd * self.ff  # (N, 6)
-        self.ctrl = self.servo.copy()
-        self.ctrl[1:] = 0.5 * (self.servo[1:] + self.servo[:-1])
+        self._ramp = (np.arange(self.nsub) + 0.5) / self.nsub  # each physics step's mean point on the cycle's line
         d.ctrl[self.act_ids] = self.servo[0]
-        # Acceleration feed-forward per cycle (cycle means, like the command), or None (SimConfig.accel_feedforward).
+        # Acceleration feed-forward per cycle (the mean of samples k-1 and k), or None (SimConfig.accel_feedforward).
         self.kp = kp
         self.acc: FloatArray | None = None
         if cfg.accel_feedforward:
             self.acc = tr.qdd.copy()
             self.acc[1:] = 0.5 * (tr.qdd[1:] + tr.qdd[:-1])
         self._acc_vec, self._acc_res = np.zeros(m.nv), np.zeros(m.nv)
+        self._last_acc = np.zeros(N_JOINTS)  # reference acceleration of the last sample streamed [rad/s^2]
 
         self.cup = SuctionCup(scene, cfg.suction, seed=cfg.seed)
         self.events: list[FeedbackEvent] = []
@@ -192,23 +194,23 @@ class _Run:
 
     # ------------------------------------------------------------------------------------------ one control cycle
 
-    def step_cycle(self, ctrl_k: FloatArray, split_after: int = 0,
+    def step_cycle(self, cmd_from: FloatArray, cmd_to: FloatArray, split_after: int = 0,
                    on_split: Callable[[], None] | None = None, acc_k: FloatArray | None = None) -> GripperInput:
-        """Hold ``ctrl_k`` (plus the acceleration feed-forward of ``acc_k`` [rad/s^2], if given) for one control
-        cycle (``on_split`` runs after ``split_after`` physics steps), render, pace, record the joints, and read
-        ``gripper_input`` like the driver does every cycle."""
+        """Move the servo command linearly from ``cmd_from`` to ``cmd_to`` over one control cycle (plus the
+        acceleration feed-forward of ``acc_k`` [rad/s^2], if given; ``on_split`` runs after ``split_after`` physics
+        steps), render, pace, record the joints, and read ``gripper_input`` like the driver does every cycle."""
         m, d = self.m, self.d
+        offset = 0.0
         if acc_k is not None:  # + M(q) qdd / kp: the joint-space inertia (armature included) at the current pose
             self._acc_vec[self.scene.arm_dadr] = acc_k
             mujoco.mj_mulM(m, d, self._acc_res, self._acc_vec)
-            ctrl_k = ctrl_k + self._acc_res[self.scene.arm_dadr] / self.kp
-        d.ctrl[self.act_ids] = ctrl_k
-        if split_after and on_split is not None:
-            mujoco.mj_step(m, d, nstep=split_after)
-            on_split()
-            mujoco.mj_step(m, d, nstep=self.nsub - split_after)
-        else:
-            mujoco.mj_step(m, d, nstep=self.nsub)
+            offset = self._acc_res[self.scene.arm_dadr] / self.kp
+        delta = cmd_to - cmd_from
+        for j, r in enumerate(self._ramp):
+            d.ctrl[self.act_ids] = cmd_from + r * delta + offset
+            mujoco.mj_step(m, d)
+            if j + 1 == split_after and on_split is not None:
+                on_split()
         if self.frames is not None and d.time + 1e-9 >= self.next_frame:
             self.frames(m, d)
             self.next_frame += self.frame_dt
@@ -248,10 +250,12 @@ class _Run:
                 cup.command(want)
             cup.update()
             if k == self.drop_k:
-                fb = self.step_cycle(self.ctrl[k], split_after=1, on_split=partial(self._inject_drop, mv),
+                fb = self.step_cycle(self.servo[k - 1], self.servo[k], split_after=1,
+                                     on_split=partial(self._inject_drop, mv),
                                      acc_k=None if self.acc is None else self.acc[k])
             else:
-                fb = self.step_cycle(self.ctrl[k], acc_k=None if self.acc is None else self.acc[k])
+                fb = self.step_cycle(self.servo[k - 1], self.servo[k],
+                                     acc_k=None if self.acc is None else self.acc[k])
             err = np.abs(self.joints[-1][1] - tr.q[k]).max()
             if err > self.max_err:
                 self.max_err = float(err)
@@ -265,6 +269,7 @@ class _Run:
             if self.progress is not None and k % report_every == 0:
                 self.progress(k / (n - 1), f"move {max(mv, 0) + 1}/{len(moves)}")
         self.ref_chunks.append((tr.q[:k + 1], tr.qd[:k + 1], tr.qdd[:k + 1]))
+        self._last_acc = tr.qdd[k]
         return fault
 
     def _track_grasp(self, mv: int) -> None:
@@ -321,13 +326,14 @@ class _Run:
     # ------------------------------------------------------------------------------------------ 3. halt / settle
 
     def _stream(self, qs: FloatArray, vs: FloatArray, accs: FloatArray, last: FloatArray) -> FloatArray:
-        """Stream reference samples (with feed-forward, cycle means as for the plan) from the command ``last``;
+        """Stream reference samples (with feed-forward, interpolated as for the plan) from the command ``last``;
         returns the last command."""
         self.ref_chunks.append((qs, vs, accs))
-        for q_k, v_k in zip(qs, vs, strict=True):
+        for q_k, v_k, a_k in zip(qs, vs, accs, strict=True):
             cmd = q_k + self.ff * v_k
-            self.step_cycle(0.5 * (last + cmd))  # cycle mean, as for the plan
-            last = cmd
+            acc = None if self.acc is None else 0.5 * (self._last_acc + a_k)
+            self.step_cycle(last, cmd, acc_k=acc)  # as for the plan
+            last, self._last_acc = cmd, a_k
         return last
 
     def halt(self, fault: _Fault, profile: HaltProfile) -> FloatArray:
@@ -354,7 +360,7 @@ class _Run:
         z = np.zeros((n, N_JOINTS))
         self.ref_chunks.append((np.tile(q_final_ref, (n, 1)), z, z))
         for _ in range(n):
-            self.step_cycle(q_final_ref)
+            self.step_cycle(q_final_ref, q_final_ref)
 
     # ------------------------------------------------------------------------------------------ 4. verification
 
