@@ -108,13 +108,15 @@ def test_placing_onto_a_stack_close_to_the_line_leaves_the_block_in_place(lab_re
     assert check_vertical(plan.trajectory, plan.moves, tall, 0.002)[0] == []
 
 
-def test_without_the_placing_band_the_stack_is_tilted_and_the_block_thrown(lab_real: Station,
-                                                                         no_place_band: float) -> None:
-    """The rule is what keeps the block in place: without it the same placement touches down ~0.7 mm off the
-    line and the block ends 0.68 mm off its slot (measured), and the plan's own check, with the band, refuses it."""
+def test_a_block_touching_down_off_the_line_slides_on_the_stack_instead_of_tilting_it(lab_real: Station,
+                                                                                     no_place_band: float) -> None:
+    """Without the placing band the same placement touches down ~0.7 mm off the line, still closing in on it (the
+    plan's own check, with the band, refuses it). At friction 1.0 the block dragged the stack's top with it, tilted
+    the stack and, released, was thrown 0.68 mm off its slot (measured); at wood-on-wood friction
+    (:class:`ur3hanoi.sim.SceneConfig`) it slides on the stack into place and ends 0.01 mm off (measured)."""
     tall = _tall(lab_real, 8)
     off, plan = _placed_on_tower_1(tall)
-    assert off > 0.0004
+    assert off < 0.0002
     assert check_vertical(plan.trajectory, plan.moves, tall, 0.002)[0] == []  # the 2 mm corridor alone passes it
     vertical.PLACE_TOL_M = no_place_band  # restored by the fixture's monkeypatch
     assert check_vertical(plan.trajectory, plan.moves, tall, 0.002)[0] != []
