@@ -71,8 +71,9 @@ class JointDrive:
 # (kv/kp = 50 ms) the cup was still 0.02-0.03 mm off the line when the suction switched at a dwell, and, held by
 # the grasped block resting under friction, stayed there: 8 blocks on a tall grid (255 moves) drifted the top block
 # 4.8 mm (bench/bench_executes.py). Four times that (kv/kp = 25 ms, the same damping ratio; a 3 kg payload at
-# 0.5 m still sags 0.9 mm) settles the cup to 0.003 mm within 0.1 s of a dwell's start, and keeps the explicit
-# spring stable at the 2 ms step (sqrt(kp / armature) * dt = 0.57 / 0.45 < 2).
+# 0.5 m still sags 0.9 mm) settles the cup to 0.003 mm within 0.1 s of a dwell's start (the top block then ends
+# 1.15 mm off, 2.34 mm with the softer servo and every other correction), and keeps the explicit spring stable at
+# the 2 ms step (sqrt(kp / armature) * dt = 0.57 / 0.45 < 2).
 DRIVES: dict[str, JointDrive] = {
     "size3": JointDrive(kp=8000.0, kv=200.0, armature=0.1, force_limit=56.0),
     "size1": JointDrive(kp=2000.0, kv=24.0, armature=0.04, force_limit=12.0),
