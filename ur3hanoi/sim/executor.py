@@ -64,6 +64,9 @@ class SimConfig:
         settle_s: time [s] simulated at rest after the last sample (blocks settle, the servo converges).
         knock_tolerance: after a halt, a block that rested when the fault was detected and has since moved
             farther than this [m] was knocked (e.g. by the dropped block) and is reported.
+        accel_feedforward: add the arm's own inertia times the reference acceleration, ``M(q) qdd_ref / kp``, to
+            the servo command (the UR controller moves on a model of its arm; velocity feed-forward alone left the
+            cup ~0.2 mm below the contact pose at the end of a place, pressing the block into the stack).
     """
 
     scene: SceneConfig = field(default_factory=SceneConfig)
@@ -74,6 +77,7 @@ class SimConfig:
     halt_speed: float = 0.5
     settle_s: float = 0.3
     knock_tolerance: float = 0.001
+    accel_feedforward: bool = True
 
 
 class FrameSink(Protocol):
@@ -142,14 +146,23 @@ class _Run:
         kp = m.actuator_gainprm[self.act_ids, 0]
         kv = -m.actuator_biasprm[self.act_ids, 2]
         self.ff = kv / kp  # feed-forward velocity gain [s]
-        # The reference held during cycle k is the mean of the (linearly interpolated) servo command over that
-        # cycle, i.e. the average of samples k-1 and k: a zero-order hold of the end sample would lead the
-        # trajectory by a full cycle (measured: 0.67 deg error at the wrist instead of 0.13 deg). Precomputed: the
-        # loop is Python-bound.
+        # During cycle k the servo command moves linearly from sample k-1 to sample k, like a UR controller
+        # interpolating its servo targets: each physics step holds the mean of that line over the step. A zero-order
+        # hold of the end sample would lead the trajectory by a full cycle (measured: 0.67 deg error at the wrist
+        # instead of 0.13 deg); holding the cycle's mean lags it by half a cycle, which the stiff servo
+        # (ur3hanoi.sim.model.DRIVES) paid for with kp * v * 4 ms of torque: the wrists saturated at 12 N m
+        # returning home after a halt. Precomputed: the loop is Python-bound.
         self.servo = tr.q + tr.qd * self.ff  # (N, 6)
-        self.ctrl = self.servo.copy()
-        self.ctrl[1:] = 0.5 * (self.servo[1:] + self.servo[:-1])
+        self._ramp = (np.arange(self.nsub) + 0.5) / self.nsub  # each physics step's mean point on the cycle's line
         d.ctrl[self.act_ids] = self.servo[0]
+        # Acceleration feed-forward per cycle (the mean of samples k-1 and k), or None (SimConfig.accel_feedforward).
+        self.kp = kp
+        self.acc: FloatArray | None = None
+        if cfg.accel_feedforward:
+            self.acc = tr.qdd.copy()
+            self.acc[1:] = 0.5 * (tr.qdd[1:] + tr.qdd[:-1])
+        self._acc_vec, self._acc_res = np.zeros(m.nv), np.zeros(m.nv)
+        self._last_acc = np.zeros(N_JOINTS)  # reference acceleration of the last sample streamed [rad/s^2]
 
         self.cup = SuctionCup(scene, cfg.suction, seed=cfg.seed)
         self.events: list[FeedbackEvent] = []
@@ -181,18 +194,23 @@ class _Run:
 
     # ------------------------------------------------------------------------------------------ one control cycle
 
-    def step_cycle(self, ctrl_k: FloatArray, split_after: int = 0,
-                   on_split: Callable[[], None] | None = None) -> GripperInput:
-        """Hold ``ctrl_k`` for one control cycle (``on_split`` runs after ``split_after`` physics steps), render,
-        pace, record the joints, and read ``gripper_input`` like the driver does every cycle."""
+    def step_cycle(self, cmd_from: FloatArray, cmd_to: FloatArray, split_after: int = 0,
+                   on_split: Callable[[], None] | None = None, acc_k: FloatArray | None = None) -> GripperInput:
+        """Move the servo command linearly from ``cmd_from`` to ``cmd_to`` over one control cycle (plus the
+        acceleration feed-forward of ``acc_k`` [rad/s^2], if given; ``on_split`` runs after ``split_after`` physics
+        steps), render, pace, record the joints, and read ``gripper_input`` like the driver does every cycle."""
         m, d = self.m, self.d
-        d.ctrl[self.act_ids] = ctrl_k
-        if split_after and on_split is not None:
-            mujoco.mj_step(m, d, nstep=split_after)
-            on_split()
-            mujoco.mj_step(m, d, nstep=self.nsub - split_after)
-        else:
-            mujoco.mj_step(m, d, nstep=self.nsub)
+        offset = 0.0
+        if acc_k is not None:  # + M(q) qdd / kp: the joint-space inertia (armature included) at the current pose
+            self._acc_vec[self.scene.arm_dadr] = acc_k
+            mujoco.mj_mulM(m, d, self._acc_res, self._acc_vec)
+            offset = self._acc_res[self.scene.arm_dadr] / self.kp
+        delta = cmd_to - cmd_from
+        for j, r in enumerate(self._ramp):
+            d.ctrl[self.act_ids] = cmd_from + r * delta + offset
+            mujoco.mj_step(m, d)
+            if j + 1 == split_after and on_split is not None:
+                on_split()
         if self.frames is not None and d.time + 1e-9 >= self.next_frame:
             self.frames(m, d)
             self.next_frame += self.frame_dt
@@ -232,9 +250,12 @@ class _Run:
                 cup.command(want)
             cup.update()
             if k == self.drop_k:
-                fb = self.step_cycle(self.ctrl[k], split_after=1, on_split=partial(self._inject_drop, mv))
+                fb = self.step_cycle(self.servo[k - 1], self.servo[k], split_after=1,
+                                     on_split=partial(self._inject_drop, mv),
+                                     acc_k=None if self.acc is None else self.acc[k])
             else:
-                fb = self.step_cycle(self.ctrl[k])
+                fb = self.step_cycle(self.servo[k - 1], self.servo[k],
+                                     acc_k=None if self.acc is None else self.acc[k])
             err = np.abs(self.joints[-1][1] - tr.q[k]).max()
             if err > self.max_err:
                 self.max_err = float(err)
@@ -248,6 +269,7 @@ class _Run:
             if self.progress is not None and k % report_every == 0:
                 self.progress(k / (n - 1), f"move {max(mv, 0) + 1}/{len(moves)}")
         self.ref_chunks.append((tr.q[:k + 1], tr.qd[:k + 1], tr.qdd[:k + 1]))
+        self._last_acc = tr.qdd[k]
         return fault
 
     def _track_grasp(self, mv: int) -> None:
@@ -304,13 +326,14 @@ class _Run:
     # ------------------------------------------------------------------------------------------ 3. halt / settle
 
     def _stream(self, qs: FloatArray, vs: FloatArray, accs: FloatArray, last: FloatArray) -> FloatArray:
-        """Stream reference samples (with feed-forward, cycle means as for the plan) from the command ``last``;
+        """Stream reference samples (with feed-forward, interpolated as for the plan) from the command ``last``;
         returns the last command."""
         self.ref_chunks.append((qs, vs, accs))
-        for q_k, v_k in zip(qs, vs, strict=True):
+        for q_k, v_k, a_k in zip(qs, vs, accs, strict=True):
             cmd = q_k + self.ff * v_k
-            self.step_cycle(0.5 * (last + cmd))  # cycle mean, as for the plan
-            last = cmd
+            acc = None if self.acc is None else 0.5 * (self._last_acc + a_k)
+            self.step_cycle(last, cmd, acc_k=acc)  # as for the plan
+            last, self._last_acc = cmd, a_k
         return last
 
     def halt(self, fault: _Fault, profile: HaltProfile) -> FloatArray:
@@ -337,7 +360,7 @@ class _Run:
         z = np.zeros((n, N_JOINTS))
         self.ref_chunks.append((np.tile(q_final_ref, (n, 1)), z, z))
         for _ in range(n):
-            self.step_cycle(q_final_ref)
+            self.step_cycle(q_final_ref, q_final_ref)
 
     # ------------------------------------------------------------------------------------------ 4. verification
 
@@ -406,10 +429,11 @@ def run_plan(plan: Plan, faults: Faults | None = None, config: SimConfig | None 
     """Execute ``plan`` in MuJoCo like the lab program: stream, operate suction, check feedback, halt on faults.
 
     Each control cycle (``1 / rate_hz`` [s], 4 physics steps at 125 Hz / 2 ms) commands the next trajectory
-    sample with velocity feed-forward, ``ctrl = q_ref + (kv/kp) * qd_ref``, so the servo force is
-    ``kp (q_ref - q) + kv (qd_ref - qd)``; then reads ``gripper_input``. A block must be held at the end of every
-    GRASP_DWELL and in every cycle of a carrying phase; otherwise the arm decelerates to rest (Ruckig, from the
-    reference state), the suction is turned off and the arm returns home (Ruckig), and
+    sample with velocity and acceleration feed-forward, ``ctrl = q_ref + (kv/kp) * qd_ref + M(q) qdd_ref / kp``,
+    so the servo force is ``kp (q_ref - q) + kv (qd_ref - qd) + M(q) qdd_ref``; then reads ``gripper_input``. A
+    block must be held at the end of every GRASP_DWELL and in every cycle of a carrying phase; otherwise the arm
+    decelerates to rest (Ruckig, from the reference state), the suction is turned off and the arm returns home
+    (Ruckig), and
     :class:`~ur3hanoi.errors.SuctionFaultError` is raised with the "halted" :class:`SimResult` as ``.result``.
 
     Args:

@@ -65,11 +65,18 @@ class JointDrive:
 
 
 # Joints 1-3 ("size3": base, shoulder, elbow) and wrists ("size1"). kv is about critical damping for the joint's
-# largest effective inertia; kp keeps the acceleration-induced lag (~I*qdd/kp) near 0.1 deg at the planner's
-# 4 rad/s^2 (joints 1-3) / 8 rad/s^2 (wrists).
+# largest effective inertia (kv^2 / 4 kp = 1.25 / 0.072 kg m^2). kp is the servo's holding stiffness: a UR3 holds
+# its pose within its +-0.1 mm repeatability (datasheet) because its joint controller has integral action; this PD
+# has none, so a load or a contact force deflects it by torque/kp and an error decays with kv/kp. At 2000/500 N m/rad
+# (kv/kp = 50 ms) the cup was still 0.02-0.03 mm off the line when the suction switched at a dwell, and, held by
+# the grasped block resting under friction, stayed there: 8 blocks on a tall grid (255 moves) drifted the top block
+# 4.8 mm (bench/bench_executes.py). Four times that (kv/kp = 25 ms, the same damping ratio; a 3 kg payload at
+# 0.5 m still sags 0.9 mm) settles the cup to 0.003 mm within 0.1 s of a dwell's start (the top block then ends
+# 1.15 mm off, 2.34 mm with the softer servo and every other correction), and keeps the explicit spring stable at
+# the 2 ms step (sqrt(kp / armature) * dt = 0.57 / 0.45 < 2).
 DRIVES: dict[str, JointDrive] = {
-    "size3": JointDrive(kp=2000.0, kv=100.0, armature=0.1, force_limit=56.0),
-    "size1": JointDrive(kp=500.0, kv=12.0, armature=0.04, force_limit=12.0),
+    "size3": JointDrive(kp=8000.0, kv=200.0, armature=0.1, force_limit=56.0),
+    "size1": JointDrive(kp=2000.0, kv=24.0, armature=0.04, force_limit=12.0),
 }
 # Elbow torque limit is 28 N m (datasheet), the other size3 joints 56 N m: class size3_elbow overrides it.
 _ELBOW_FORCE_LIMIT = 28.0  # [N m]

@@ -85,7 +85,7 @@ class JointTrace:
     Attributes:
         t: (N,) sim time [s].
         q_ref, qd_ref, qdd_ref: (N, 6) the streamed reference [rad, rad/s, rad/s^2]; the servo is commanded
-            ``q_ref + (kv/kp) qd_ref``, averaged over the cycle.
+            ``q_ref + (kv/kp) qd_ref`` (+ ``M(q) qdd_ref / kp``), interpolated linearly over the cycle.
         q, qd: (N, 6) the simulated joints at the end of the cycle [rad, rad/s]. Their acceleration over a cycle
             is ``diff(qd) / diff(t)``; MuJoCo's instantaneous ``qacc`` is not recorded: it swings to 10-20 times the
             planned acceleration within a cycle (2 ms steps, a command change every cycle) even on a smooth plan.

@@ -44,9 +44,18 @@ class SceneConfig:
     Attributes:
         timestep: physics step [s]; 2 ms or less (the UR3 servo loop runs at 8 ms, 4 steps per cycle).
         block_mass: [kg], the lab's 1.25 in wooden cubes.
-        friction: sliding friction of blocks and table.
-        weld_solref: (timeconst [s], dampratio) of the suction weld: stiff enough that a block slips < 1 mm in a
-            full-speed swing, soft enough to stay stable at the 2 ms step.
+        friction: sliding friction of blocks and table: 0.5, the upper end of dry wood on wood (0.25-0.5, the
+            usual handbook range). At 1.0 (rubber on wood) a block touching down while the cup still closed in on
+            the vertical line (up to ~0.3 mm at 10-20 mm/s in the plan's last millimetre) did not slide on the
+            stack's top but dragged it: the stack tilted ~0.05-0.1 deg and, released, sprang back and threw the top
+            block 0.1-0.25 mm (measured, tall grid tower 3 height 6); 8 blocks on a tall grid (the other settings as
+            now) ended with the top block over 5 mm off, failing the final check.
+        weld_solref: (timeconst [s], dampratio) of the suction weld, i.e. how rigidly the cup holds the block.
+            0.004 s, the stiffest stable at the 2 ms step (as for the contacts): a vacuum cup sealed on a flat face
+            holds a 22.5 g block practically rigidly. At 0.01 s the block shifted 0.03-0.05 mm in the cup per move
+            (pulled back by the stack at touch-down, sagging and swinging on the way), always the same way, and a
+            grasp keeps the offset: 8 blocks on a tall grid (the other settings as now) drifted over 5 mm, failing the
+            final check.
         noslip_iterations: MuJoCo's no-slip solver passes. Without them the soft contacts let a resting stack
             creep sideways (measured: the top of a 4-block stack slid 0.1-0.2 mm/s with nothing touching it), and
             since a grasp keeps the block's offset in the cup, the creep accumulated into 5-8 mm misplacements
@@ -59,8 +68,8 @@ class SceneConfig:
 
     timestep: float = 0.002
     block_mass: float = 0.0225
-    friction: float = 1.0
-    weld_solref: tuple[float, float] = (0.01, 1.0)
+    friction: float = 0.5
+    weld_solref: tuple[float, float] = (0.004, 1.0)
     noslip_iterations: int = 10
     contact_solref: tuple[float, float] = (0.004, 1.0)
 
