@@ -119,3 +119,29 @@ def test_a_plan_from_the_user_cache_needs_no_pinocchio_coal_or_scipy(tmp_path: P
     assert code_first == code == 0
     assert {"pinocchio", "coal"} <= {m.split(".")[0] for m in first}  # the first run checks the clearances
     assert {m.split(".")[0] for m in loaded} == {"numpy", "yaml", "ruckig"}, loaded
+
+
+def _subparsers(parser: object) -> dict[str, object]:
+    return next(a for a in parser._actions if a.dest == "command").choices  # type: ignore[attr-defined, no-any-return]
+
+
+def test_a_command_builds_only_its_own_parser(monkeypatch: object) -> None:
+    """Every command is in :data:`COMMAND_MODULES`, its own parser is the full parser's to the letter, and a run
+    imports no other command's module."""
+    from ur3hanoi.cli.main import COMMAND_MODULES
+
+    monkeypatch.setenv("COLUMNS", "100")  # type: ignore[attr-defined]
+    full = _subparsers(build_parser())
+    assert list(COMMAND_MODULES) == list(full)
+    for name in COMMAND_MODULES:
+        own = _subparsers(build_parser(name))
+        assert name in own and len(own) < len(full)
+        assert own[name].format_help() == full[name].format_help()  # type: ignore[attr-defined]
+    probe = ("import sys, contextlib, io, json\nimport ur3hanoi.cli\n"
+             "with contextlib.redirect_stdout(io.StringIO()):\n    ur3hanoi.cli.main(['tables', '--help'])\n"
+             "print(json.dumps(sorted(m for m in sys.modules if m.startswith('ur3hanoi.cli.'))))")
+    proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, cwd=REPO, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    loaded = {m.removeprefix("ur3hanoi.cli.") for m in json.loads(proc.stdout)}
+    others = set(COMMAND_MODULES.values()) - {"tables"}
+    assert loaded & others == set(), f"tables imported {sorted(loaded & others)}"
