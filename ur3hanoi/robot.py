@@ -83,8 +83,8 @@ CONTROL_PERIOD_S = CB3_CONTROL_PERIOD_S
 # acceleration, which at 125 Hz is exactly such a one-cycle ramp: a planner with a lower jerk is slower than the
 # program it replaces for no physical reason (20/40 rad/s^3 made the plan 4 % slower than the lab program). What
 # this costs the carried block is measured by bench/bench_suction_hold.py (bench/REPORT.md): in MuJoCo the suction
-# weld stretches at most 0.64 mm on lab_sim and 0.27 mm on lab_real at 100-2000 rad/s^3, against the 10 mm at
-# which the seal counts as broken (SuctionConfig.hold_tolerance): a margin above 15.
+# weld (0.004 s) stretches at most 0.056 mm on lab_sim and 0.078 mm on lab_real at 100-2000 rad/s^3, against the
+# 10 mm at which the seal counts as broken (SuctionConfig.hold_tolerance): a margin above 100.
 DEFAULT_JERK_MAX: tuple[float, ...] = UR3.j_max  # = a_max / CONTROL_PERIOD_S (the registry's UR3 entry)
 
 
