@@ -55,7 +55,8 @@ def check_segments(segments: Sequence[Segment], moves: Sequence[Move], station: 
 
     plan = repr((tuple(moves), n_blocks, start, config, limits.v_max.tolist(), limits.a_max.tolist(),
                  limits.j_max.tolist())).encode()
-    inputs = [*station_inputs(geometry_key(station)), *_geometry_inputs(geometry_key(station)), plan,
+    geometry = geometry_key(station)
+    inputs = [*station_inputs(geometry), *_geometry_inputs(geometry), plan,
               motion_digest(segments, trajectory)]
     return cached(CLEARANCE, inputs, build, lambda v: json.dumps(v).encode(), _decode)
 
