@@ -7,9 +7,10 @@ an 18-pose IK table <= 1 ms.
 
 Each command is a new process of this interpreter (`python -m ur3hanoi ...`, as a fresh clone runs it), timed from
 start to exit; figures are the median (and best) of N runs after one warm-up run, with the median CPU time (user +
-system) of the process. Byte code is cached as after an install (PYTHONDONTWRITEBYTECODE is dropped; the cache goes
-to a temporary PYTHONPYCACHEPREFIX), and the user's cache is a temporary XDG_CACHE_HOME: the first `plan` of a station
-fills it (the planner's connections and waypoints, the collision geometry; reported apart), the timed ones use it.
+system) of the process. The interpreter's floor and every `--help` run in interleaved rounds (one of each per
+round). Byte code is cached as after an install (PYTHONDONTWRITEBYTECODE is dropped; the cache goes to a temporary
+PYTHONPYCACHEPREFIX), and the user's cache is a temporary XDG_CACHE_HOME: the first `plan` of a station fills it
+(the planner's connections and waypoints, the collision geometry; reported apart), the timed ones use it.
 Wall times on a shared machine grow with its load (printed beside them); the CPU time of a single-threaded command
 does not wait for a core (the command keeps numpy's BLAS on one thread, see ur3hanoi/cli/__init__.py).
 """
@@ -75,6 +76,17 @@ class Runner:
         if warm_up:
             self.once(argv)
         return [self.once(argv) for _ in range(runs)]
+
+    def rounds(self, argvs: Sequence[Sequence[str]], runs: int) -> list[list[Timing]]:
+        """Each of ``argvs`` once per round, ``runs`` rounds after a warm-up round: a slow spell of a shared
+        machine then slows every command (and the floor) alike instead of whichever was running."""
+        for argv in argvs:
+            self.once(argv)
+        timings: list[list[Timing]] = [[] for _ in argvs]
+        for _ in range(runs):
+            for argv, out in zip(argvs, timings, strict=True):
+                out.append(self.once(argv))
+        return timings
 
 
 class Timing(NamedTuple):
@@ -160,11 +172,11 @@ def main() -> int:
     print(f"machine: {machine()}; load average {load_average()} at start")
     with tempfile.TemporaryDirectory(prefix="ur3hanoi-bench-") as tmp_name:
         run = Runner(Path(tmp_name))
-        floor = run.timed(["-c", "pass"], args.runs)
+        helps = [["-m", "ur3hanoi", *argv, "--help"] for argv in ([], *([c] for c in commands))]
+        floor, *help_runs = run.rounds([["-c", "pass"], *helps], args.runs)
         print(f"python -c pass (the interpreter's own start, the floor): {summary(floor)}")
-        for argv in ([], *([c] for c in commands)):
-            walls = run.timed(["-m", "ur3hanoi", *argv, "--help"], args.runs)
-            print(f"ur3hanoi {' '.join([*argv, '--help'])}: {summary(walls, HELP_TARGET_S)}")
+        for argv, walls in zip(helps, help_runs, strict=True):
+            print(f"ur3hanoi {' '.join(argv[2:])}: {summary(walls, HELP_TARGET_S)}")
         warm_up = ["-m", "ur3hanoi", "plan", "--start", "1", "--end", "3"]
         run.once(warm_up, XDG_CACHE_HOME=str(Path(tmp_name) / "throwaway"))  # byte code only, not the user cache
         for station in ("lab_sim", "lab_real"):
