@@ -1,0 +1,62 @@
+"""A lab table file as a whole: its keys, and reading it as a mapping of keys (without checking any key).
+
+What every reader and the writer share; NumPy-free, so that writing an already generated key (``ur3hanoi tables``
+with its key in the user's cache) imports no numerical library. Checking a key's value is
+:mod:`~ur3hanoi.labfile.read`'s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ur3hanoi.errors import TableError, quote
+from ur3hanoi.io.yaml_loader import load_yaml_file
+
+TABLE_KEYS: tuple[str, ...] = ("sim_pos", "real_pos")
+"""The table keys: ``sim_pos`` (the course's Gazebo simulator), ``real_pos`` (the real robot)."""
+BLOCK_XY_KEY = "block_xy_pos"
+"""The key of the block positions ``[tower][height] -> [x, y]`` [m, world] of a flat (simulator) layout."""
+WHAT = "lab table file"
+"""How messages name the file kind."""
+KNOWN_KEYS: tuple[str, ...] = (*TABLE_KEYS, BLOCK_XY_KEY)
+"""ur3hanoi's keys (those of :data:`ur3hanoi.labfile.read.LAB_FILE_SCHEMA`); any other key is the student's."""
+
+
+@dataclass(frozen=True)
+class LabFile:
+    """A lab table file whose top level is a mapping: ``data`` (key -> value, not checked), its ``text`` (without
+    a byte-order mark; ``bom`` says whether the file had one) and the sha256 of its bytes."""
+
+    data: dict[Any, Any]
+    text: str
+    sha256: str
+    bom: bool = False
+
+
+def read_lab_file(path: str | Path, source: str | None = None) -> LabFile:
+    """Read a lab table file (strict YAML); ``source`` names it in messages. Only the top level is checked (a
+    mapping, or an empty file): each key is checked when it is read (:func:`ur3hanoi.labfile.read.lab_key`).
+
+    Raises:
+        TableError: unreadable, not strict YAML, or its top level is not a mapping; the message names the file.
+    """
+    source = str(path) if source is None else source
+    doc = load_yaml_file(path, what=WHAT, error=TableError, source=source)
+    data = {} if doc.data is None else doc.data
+    if not isinstance(data, dict):
+        from ur3hanoi.io.schema import describe_type
+
+        raise TableError.file(source, f"the top level is {describe_type(data)}, not a mapping of keys "
+                                      f"({', '.join(KNOWN_KEYS)}, or your own): not a {WHAT}")
+    return LabFile(data=data, text=doc.text, sha256=doc.sha256, bom=doc.bom)
+
+
+def check_key(key: str) -> None:
+    """Refuse a table key other than :data:`TABLE_KEYS`."""
+    if key not in TABLE_KEYS:
+        raise TableError(f"table key {quote(key)} is invalid: expected one of {', '.join(TABLE_KEYS)}")
+
+
+__all__ = ["BLOCK_XY_KEY", "KNOWN_KEYS", "TABLE_KEYS", "WHAT", "LabFile", "check_key", "read_lab_file"]
