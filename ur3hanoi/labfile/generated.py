@@ -25,8 +25,7 @@ from __future__ import annotations
 
 import json
 import sys
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 from ur3hanoi.cache import cached, installed_versions, source_digest
 from ur3hanoi.errors import CalibrationError, InputError
@@ -46,9 +45,9 @@ LIBRARIES: tuple[str, ...] = ("numpy", "pin", "placo", "example_robot_data", "py
 """The distributions whose versions are in the key (as their ``.dist-info`` folders spell them)."""
 
 
-@dataclass(frozen=True)
-class GeneratedKey:
-    """A generated table key: what ``ur3hanoi tables`` writes and prints.
+class GeneratedKey(NamedTuple):
+    """A generated table key: what ``ur3hanoi tables`` writes and prints (a named tuple, like
+    :class:`~ur3hanoi.labfile.update.Sections`).
 
     Attributes:
         sections: the keys to write (:func:`~ur3hanoi.labfile.update.write_sections`).

@@ -15,19 +15,15 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import yaml
 
 from ur3hanoi.errors import TableError
 from ur3hanoi.labfile.format import FILE_HEADER, format_flow
 
-# ------------------------------------------------------------------------------------------------ the layout
 
-
-@dataclass(frozen=True)
-class _Entry:
+class _Entry(NamedTuple):
     """A top-level key of the file: ``start`` (the key's first character), ``end`` (just past the value's last
     character) as text indices, and the key's text."""
 
@@ -36,8 +32,7 @@ class _Entry:
     end: int
 
 
-@dataclass(frozen=True)
-class _Layout:
+class _Layout(NamedTuple):
     """Where the top-level mapping's entries are; ``flow`` for ``{...}``; ``close`` is the index of a flow
     mapping's ``}``."""
 

@@ -12,9 +12,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from ur3hanoi.errors import TableError, printable
 from ur3hanoi.io.atomic import locked_output
@@ -24,9 +23,9 @@ from ur3hanoi.labfile.format import ANGLE_DECIMALS
 from ur3hanoi.labfile.splice import splice_yaml
 
 
-@dataclass(frozen=True)
-class Sections:
-    """Keys of a lab table file as ur3hanoi generated them, ready to be written.
+class Sections(NamedTuple):
+    """Keys of a lab table file as ur3hanoi generated them, ready to be written (a named tuple: it is created on
+    every ``tables`` run, and a frozen dataclass costs a millisecond to define).
 
     Attributes:
         key: the table key they are for (``sim_pos`` or ``real_pos``; named in messages).
