@@ -12,12 +12,16 @@ import sys
 from pathlib import Path
 
 from ur3hanoi.cli import build_parser
+from ur3hanoi.cli.common import SUCTION_PROFILES
 from ur3hanoi.cli.options import TABLE_KEYS
 
 from .conftest import REPO
 
 HEAVY = ("numpy", "pinocchio", "coal", "hppfcl", "mujoco", "placo", "ruckig", "scipy", "yaml")
 """Libraries the parser must not import: each costs 10-150 ms; the commands import them where they are used."""
+HELP_UNUSED = (*HEAVY, "dataclasses", "inspect")
+"""What ``--help`` must not import either: :mod:`dataclasses` (with :mod:`inspect`, ``ast``, ``dis``) costs 8-10 ms,
+a sixth of a ``--help``; the option ranges are NamedTuples (:class:`ur3hanoi.io.number.Number`)."""
 
 _PROBE = """
 import contextlib, io, json, sys
@@ -49,7 +53,7 @@ def _probe(code: str) -> dict[str, object]:
 def test_parser_and_every_help_import_no_heavy_library() -> None:
     commands = _commands()
     assert len(commands) >= 7  # ur3hanoi itself and its commands (tables, check-table, ..., ros-env)
-    out = _probe(_PROBE.format(heavy=HEAVY, argvs=commands))
+    out = _probe(_PROBE.format(heavy=HELP_UNUSED, argvs=commands))
     assert out.pop("import") == []
     assert set(out) == {" ".join(c) or "ur3hanoi" for c in commands}
     for name, (code, n_chars, loaded) in out.items():  # type: ignore[misc]
@@ -59,8 +63,11 @@ def test_parser_and_every_help_import_no_heavy_library() -> None:
 
 def test_the_probe_sees_a_heavy_import() -> None:
     """The check can fail: the same probe after a library import reports it."""
-    out = _probe("import numpy\n" + _PROBE.format(heavy=HEAVY, argvs=[["tables"]]))
+    out = _probe("import numpy\n" + _PROBE.format(heavy=HELP_UNUSED, argvs=[["tables"]]))
     assert "numpy" in out["import"]  # type: ignore[operator]
+    out = _probe(_PROBE.format(heavy=HELP_UNUSED, argvs=[["tables"]]).replace("import ur3hanoi.cli\n",
+                                                                               "import ur3hanoi.cli, dataclasses\n"))
+    assert "dataclasses" in out["import"]  # type: ignore[operator]
 
 
 def test_parser_constants_are_the_library_constants() -> None:
@@ -69,8 +76,10 @@ def test_parser_constants_are_the_library_constants() -> None:
     from ur3hanoi.labfile import TABLE_KEYS as LAB_TABLE_KEYS
     from ur3hanoi.station import MAX_HEIGHTS as STATION_MAX_HEIGHTS
     from ur3hanoi.station import MAX_TOWERS as STATION_MAX_TOWERS
+    from ur3hanoi.suction_profile import PROFILES
 
     assert TABLE_KEYS == LAB_TABLE_KEYS
+    assert tuple(PROFILES) == SUCTION_PROFILES
     assert (MAX_TOWERS, MAX_HEIGHTS) == (STATION_MAX_TOWERS, STATION_MAX_HEIGHTS)
 
 

@@ -9,9 +9,6 @@ from pathlib import Path
 from ur3hanoi.cli.common import SYMLINK_NOTE, input_file, shown
 from ur3hanoi.cli.options import TABLE_KEYS, UsageError
 from ur3hanoi.errors import printable, quote
-from ur3hanoi.io.schema import Text
-
-_NAME = Text(max_len=255)
 
 
 def add(sub: argparse._SubParsersAction) -> None:
@@ -44,6 +41,7 @@ def run(args: argparse.Namespace) -> int:
     from ur3hanoi.audit import audit_taught
     from ur3hanoi.calibrate import fit_station, write_calibration
     from ur3hanoi.io.atomic import check_output
+    from ur3hanoi.io.schema import Text
     from ur3hanoi.labfile import read_recorded_table
     from ur3hanoi.station import load_station
     from ur3hanoi.taught import load_taught, taught_from_recorded
@@ -52,8 +50,9 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"--from-table needs --key ({' or '.join(TABLE_KEYS)})")
     if args.taught is not None and args.key is not None:
         raise UsageError("--key is only used with --from-table")
-    if args.name is not None and not _NAME.accepts(args.name):
-        raise UsageError(f"--name {quote(args.name)} is invalid: expected {_NAME.expected()}")
+    name_spec = Text(max_len=255)
+    if args.name is not None and not name_spec.accepts(args.name):
+        raise UsageError(f"--name {quote(args.name)} is invalid: expected {name_spec.expected()}")
     inputs = [input_file(args.base), Path(args.taught or args.from_table)]
     check_output(args.output, inputs=inputs)
     out = Path(args.output)
@@ -66,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
         table = read_recorded_table(args.from_table, args.key)
         taught, shared = taught_from_recorded(table), table.shared_above
         taught_label = f"{Path(args.from_table).as_posix()} key {args.key}"
-    fit = fit_station(base, taught, name=args.name or printable(out.stem, _NAME.max_len), source=str(args.output))
+    fit = fit_station(base, taught, name=args.name or printable(out.stem, name_spec.max_len), source=str(args.output))
     report = audit_taught(fit, taught, args.key or "Q", shared)
     print(json.dumps(report.to_json()) if args.json else report.text())
     sys.stdout.flush()

@@ -43,11 +43,14 @@ def shown(path: Any) -> str:
     return printable(path, 4096)
 
 
+SUCTION_PROFILES: tuple[str, ...] = ("lab_sim", "real")
+"""The names of :data:`ur3hanoi.suction_profile.PROFILES` for ``--suction-profile``, spelt out so that building the
+parser does not import the profiles (tests/test_cli_startup.py checks that both are the same)."""
+
+
 def add_suction_profile_option(p: Any) -> None:
     """``--suction-profile NAME``: a named suction feedback profile instead of the calibration's ``suction``."""
-    from ur3hanoi.suction_profile import PROFILES
-
-    p.add_argument("--suction-profile", choices=list(PROFILES), default=None,
+    p.add_argument("--suction-profile", choices=SUCTION_PROFILES, default=None,
                    help="suction feedback levels (DIGIN/AIN0 held, cup free, off): lab_sim = the course simulator's "
                         "(~1.9/1.45/1.05 V), real = a real station's (2.35/1.40/1.05 V); default: the "
                         "calibration's suction section (lab_sim without one)")

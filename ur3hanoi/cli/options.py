@@ -1,6 +1,6 @@
 """Every numeric command-line option with its valid range, parsed and checked in this one place.
 
-Each option's range is a :class:`~ur3hanoi.io.schema.Number` (the same range type the input files use), so the
+Each option's range is a :class:`~ur3hanoi.io.number.Number` (the same range type the input files use), so the
 message says what is allowed, e.g. ``argument --rate: '1e-9' is invalid: expected a sample rate [Hz] in [1,
 10000]``. Cross-option checks that need the station (blocks against the grid, the size of a plan) are here too.
 """
@@ -12,7 +12,7 @@ from collections.abc import Callable
 
 from ur3hanoi.errors import Ur3HanoiError, quote
 from ur3hanoi.io.limits import MAX_HEIGHTS, MAX_TOWERS
-from ur3hanoi.io.schema import Number
+from ur3hanoi.io.number import Number
 
 
 class UsageError(Ur3HanoiError):

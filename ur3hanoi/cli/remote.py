@@ -9,13 +9,11 @@ exit code 2; a suction fault exits with 3 (after printing the ``--json`` outcome
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from ur3hanoi.cli.common import add_suction_profile_option
 from ur3hanoi.cli.options import (
@@ -146,10 +144,10 @@ def add_json_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object with the outcome on stdout")
 
 
-@dataclass(frozen=True)
-class SolveJob:
+class SolveJob(NamedTuple):
     """What a solve subcommand runs: the table ``Q`` [rad, controller convention], the home pose [rad], towers
-    (0-based) and the number of blocks."""
+    (0-based) and the number of blocks. (A NamedTuple, not a frozen dataclass: this module builds the ``ros-*``
+    parsers, and importing dataclasses would cost every ``--help`` 8-10 ms.)"""
 
     Q: FloatArray
     home: FloatArray
@@ -213,6 +211,8 @@ def drive(args: argparse.Namespace, arm: Any, job: SolveJob, connected: str,
     """Connect ``arm`` (a :class:`ur3hanoi.remote.client.TopicArm`), say ``connected``, run the lab's solve,
     close the arm; print the outcome (one JSON object with ``--json``). A suction fault is re-raised (exit 3)
     after its outcome is printed."""
+    import json
+
     from ur3hanoi.errors import SuctionFaultError
     from ur3hanoi.remote.solve import LabSolveConfig, run_lab_solve
 

@@ -11,59 +11,14 @@ list) stay with the file kind's parser, after this check.
 from __future__ import annotations
 
 import difflib
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 from ur3hanoi.errors import MISSING, InputError, printable, quote
 from ur3hanoi.io.limits import MAX_LIST_ITEMS
+from ur3hanoi.io.number import Number as Number  # re-exported: a schema field's range is a Number
 from ur3hanoi.io.yaml11 import Yaml11Reading
-
-
-def _fmt(x: float) -> str:
-    """``0.2``, ``360``, ``4294967295`` (whole numbers in full, others shortest)."""
-    if float(x).is_integer() and abs(x) < 1e16:
-        return str(int(x))
-    return f"{x:g}"
-
-
-@dataclass(frozen=True)
-class Number:
-    """A finite number (or an integer) in a range. ``unit`` is shown in messages (``"m"`` -> ``[m]``)."""
-
-    lo: float = -math.inf
-    hi: float = math.inf
-    lo_open: bool = False
-    hi_open: bool = False
-    unit: str = ""
-    integer: bool = False
-    what: str = ""
-
-    def expected(self) -> str:
-        noun = self.what or ("an integer" if self.integer else "a number")
-        unit = f" [{self.unit}]" if self.unit else ""
-        if math.isinf(self.lo) and math.isinf(self.hi):
-            return f"{noun}{unit}" if self.integer else f"a finite {noun.split(' ', 1)[-1]}{unit}"
-        lo = "(" if self.lo_open or math.isinf(self.lo) else "["
-        hi = ")" if self.hi_open or math.isinf(self.hi) else "]"
-        return f"{noun}{unit} in {lo}{_fmt(self.lo)}, {_fmt(self.hi)}{hi}"
-
-    def accepts(self, value: Any) -> bool:
-        """True for a finite number (an int if ``integer``) inside the range; never for a bool."""
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            return False
-        if self.integer and not isinstance(value, int):
-            return False
-        x: float | int = value
-        if not isinstance(value, int) or not self.integer:
-            try:
-                x = float(value)
-            except OverflowError:  # an int too large for a float is outside any finite range
-                return False
-            if not math.isfinite(x):
-                return False
-        return not (x < self.lo or x > self.hi or (self.lo_open and x == self.lo) or (self.hi_open and x == self.hi))
 
 
 @dataclass(frozen=True)
