@@ -7,9 +7,8 @@ with its key in the user's cache) imports no numerical library. Checking a key's
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from ur3hanoi.errors import TableError, quote
 from ur3hanoi.io.yaml_loader import load_yaml_file
@@ -24,10 +23,10 @@ KNOWN_KEYS: tuple[str, ...] = (*TABLE_KEYS, BLOCK_XY_KEY)
 """ur3hanoi's keys (those of :data:`ur3hanoi.labfile.read.LAB_FILE_SCHEMA`); any other key is the student's."""
 
 
-@dataclass(frozen=True)
-class LabFile:
+class LabFile(NamedTuple):
     """A lab table file whose top level is a mapping: ``data`` (key -> value, not checked), its ``text`` (without
-    a byte-order mark; ``bom`` says whether the file had one) and the sha256 of its bytes."""
+    a byte-order mark; ``bom`` says whether the file had one) and the sha256 of its bytes. Immutable (a NamedTuple,
+    like :class:`~ur3hanoi.io.yaml_loader.YamlFile`, for the start-up time of ``tables``)."""
 
     data: dict[Any, Any]
     text: str
