@@ -33,8 +33,10 @@ Module map: :mod:`~ur3hanoi.labfile.file` (the keys, reading the file as a mappi
 (schema, reading a key, :class:`RecordedTable`), :mod:`~ur3hanoi.labfile.visits` (the entries a solve visits),
 :mod:`~ur3hanoi.labfile.format` (the text of numbers and keys), :mod:`~ur3hanoi.labfile.splice` (replacing keys in
 the file's text), :mod:`~ur3hanoi.labfile.update` (the locked atomic update, NumPy-free) and
-:mod:`~ur3hanoi.labfile.write` (a generated table's keys, then the update). A name is imported from its module on
-first use (the package itself imports none), so what needs no NumPy does not load it.
+:mod:`~ur3hanoi.labfile.unchanged` (files known to hold their keys already), :mod:`~ur3hanoi.labfile.write` (a
+generated table's keys, then the update) and :mod:`~ur3hanoi.labfile.generated` (a generated key through the user's
+cache). A name is imported from its module on first use (the package itself imports none), so what needs no NumPy
+does not load it.
 """
 
 from __future__ import annotations

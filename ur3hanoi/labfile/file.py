@@ -1,17 +1,19 @@
 """A lab table file as a whole: its keys, and reading it as a mapping of keys (without checking any key).
 
-What every reader and the writer share; NumPy-free, so that writing an already generated key (``ur3hanoi tables``
-with its key in the user's cache) imports no numerical library. Checking a key's value is
-:mod:`~ur3hanoi.labfile.read`'s.
+What every reader and the writer share; NumPy-free (and PyYAML is imported when a file is parsed), so that writing
+an already generated key (``ur3hanoi tables`` with its key in the user's cache) imports no numerical library.
+Checking a key's value is :mod:`~ur3hanoi.labfile.read`'s.
 """
 
 from __future__ import annotations
 
+import codecs
+import hashlib
 from pathlib import Path
 from typing import Any, NamedTuple
 
 from ur3hanoi.errors import TableError, quote
-from ur3hanoi.io.yaml_loader import load_yaml_file
+from ur3hanoi.io.reading import read_input_bytes
 
 TABLE_KEYS: tuple[str, ...] = ("sim_pos", "real_pos")
 """The table keys: ``sim_pos`` (the course's Gazebo simulator), ``real_pos`` (the real robot)."""
@@ -42,14 +44,27 @@ def read_lab_file(path: str | Path, source: str | None = None) -> LabFile:
         TableError: unreadable, not strict YAML, or its top level is not a mapping; the message names the file.
     """
     source = str(path) if source is None else source
-    doc = load_yaml_file(path, what=WHAT, error=TableError, source=source)
-    data = {} if doc.data is None else doc.data
+    return parse_lab_file(read_input_bytes(path, what=WHAT, error=TableError, source=source), source)
+
+
+def parse_lab_file(raw: bytes, source: str) -> LabFile:
+    """A lab table file from its bytes ``raw`` as read from the file (:func:`read_lab_file`, which reads them with
+    :func:`ur3hanoi.io.reading.read_input_bytes`). Imports PyYAML on first use.
+
+    Raises:
+        TableError: not UTF-8, not strict YAML, or its top level is not a mapping; the message names ``source``.
+    """
+    from ur3hanoi.io.yaml_loader import decode_utf8, parse_yaml
+
+    text = decode_utf8(raw, source, what=WHAT, error=TableError)
+    data = parse_yaml(text, source, what=WHAT, error=TableError)
+    data = {} if data is None else data
     if not isinstance(data, dict):
         from ur3hanoi.io.schema import describe_type
 
         raise TableError.file(source, f"the top level is {describe_type(data)}, not a mapping of keys "
                                       f"({', '.join(KNOWN_KEYS)}, or your own): not a {WHAT}")
-    return LabFile(data=data, text=doc.text, sha256=doc.sha256, bom=doc.bom)
+    return LabFile(data=data, text=text, sha256=hashlib.sha256(raw).hexdigest(), bom=raw.startswith(codecs.BOM_UTF8))
 
 
 def check_key(key: str) -> None:
@@ -58,4 +73,5 @@ def check_key(key: str) -> None:
         raise TableError(f"table key {quote(key)} is invalid: expected one of {', '.join(TABLE_KEYS)}")
 
 
-__all__ = ["BLOCK_XY_KEY", "KNOWN_KEYS", "TABLE_KEYS", "WHAT", "LabFile", "check_key", "read_lab_file"]
+__all__ = ["BLOCK_XY_KEY", "KNOWN_KEYS", "TABLE_KEYS", "WHAT", "LabFile", "check_key", "parse_lab_file",
+           "read_lab_file"]

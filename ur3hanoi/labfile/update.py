@@ -5,7 +5,9 @@
 (:func:`ur3hanoi.io.atomic.locked_output`, so concurrent writers of different keys never lose one) it reads the file
 (strict YAML, its top level a mapping: anything else is refused and the file left byte-identical), splices the keys
 in (:mod:`~ur3hanoi.labfile.splice`: every other byte kept), checks that the result reads back (every other key as
-it was, the written keys as generated) and replaces the file atomically; a byte-order mark is kept.
+it was, the written keys as generated) and replaces the file atomically; a byte-order mark is kept. A file found to
+hold the keys already is remembered in the user's cache (:mod:`~ur3hanoi.labfile.unchanged`): the same keys written
+into the same bytes again are written back without PyYAML (imported only when a file is parsed).
 """
 
 from __future__ import annotations
@@ -17,10 +19,10 @@ from typing import Any, NamedTuple
 
 from ur3hanoi.errors import TableError, printable
 from ur3hanoi.io.atomic import locked_output
-from ur3hanoi.io.yaml_loader import BOM, parse_yaml
-from ur3hanoi.labfile.file import WHAT, LabFile, check_key, read_lab_file
+from ur3hanoi.io.reading import read_input_bytes
+from ur3hanoi.labfile import unchanged
+from ur3hanoi.labfile.file import WHAT, LabFile, check_key, parse_lab_file
 from ur3hanoi.labfile.format import ANGLE_DECIMALS
-from ur3hanoi.labfile.splice import splice_yaml
 
 
 class Sections(NamedTuple):
@@ -62,13 +64,22 @@ def write_sections(path: str | Path, sections: Sections, inputs: Sequence[str | 
     key = sections.key
     check_key(key)
     with locked_output(path, inputs=inputs) as out:
-        old = read_lab_file(out.path, out.shown) if out.exists() else LabFile(data={}, text="", sha256="")
+        raw = read_input_bytes(out.path, what=WHAT, error=TableError, source=out.shown) if out.exists() else None
+        if raw is not None and unchanged.holds(raw, sections):  # checked in full before: the same bytes again
+            out.write(raw)
+            return raw.decode("utf-8-sig")
+        from ur3hanoi.io.yaml_loader import BOM
+        from ur3hanoi.labfile.splice import splice_yaml
+
+        old = parse_lab_file(raw, out.shown) if raw is not None else LabFile(data={}, text="", sha256="")
         try:
             text = splice_yaml(old.text, sections.text, sections.headers, sections.values)
         except TableError as exc:
             raise TableError(f"{printable(out.shown)}: cannot write '{key}': {exc}; file left unchanged") from None
         _check_read_back(text, old, sections, out.shown)
         out.write(BOM + text if old.bom else text)
+        if raw is not None and text == old.text:
+            unchanged.remember(raw, sections)
     return text
 
 
@@ -108,6 +119,8 @@ def _check_read_back(text: str, old: LabFile, sections: Sections, shown: str) ->
     if text == old.text:
         new_data: Any = old.data
     else:
+        from ur3hanoi.io.yaml_loader import parse_yaml
+
         try:
             new_data = parse_yaml(text, shown, what=WHAT, error=TableError)
         except TableError as exc:
