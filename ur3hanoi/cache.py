@@ -21,6 +21,7 @@ from __future__ import annotations
 import base64
 import binascii
 import contextlib
+import functools
 import hashlib
 import json
 import os
@@ -131,13 +132,20 @@ _PACKAGE = Path(__file__).resolve().parent  # ur3hanoi/
 def source_digest(folders: Iterable[str]) -> bytes:
     """sha256 of ur3hanoi's own modules in ``folders`` (relative to the package: ``""`` the top-level modules,
     ``"io"`` that package with its subpackages), each by its path and content: a key input for what that code
-    computes."""
+    computes. Each folder is read once per process."""
     h = hashlib.sha256()
     for folder in folders:
-        root = _PACKAGE / folder
-        for path in sorted(root.rglob("*.py") if folder else root.glob("*.py")):
-            h.update(path.relative_to(_PACKAGE).as_posix().encode() + b"\0")
-            h.update(hashlib.sha256(path.read_bytes()).digest())
+        h.update(_folder_digest(folder))
+    return h.digest()
+
+
+@functools.lru_cache(maxsize=16)
+def _folder_digest(folder: str) -> bytes:
+    h = hashlib.sha256()
+    root = _PACKAGE / folder
+    for path in sorted(root.rglob("*.py") if folder else root.glob("*.py")):
+        h.update(path.relative_to(_PACKAGE).as_posix().encode() + b"\0")
+        h.update(hashlib.sha256(path.read_bytes()).digest())
     return h.digest()
 
 
