@@ -32,11 +32,11 @@ concurrent writers of different keys never lose one. :func:`write_sections` writ
 Module map: :mod:`~ur3hanoi.labfile.file` (the keys, reading the file as a mapping), :mod:`~ur3hanoi.labfile.read`
 (schema, reading a key, :class:`RecordedTable`), :mod:`~ur3hanoi.labfile.visits` (the entries a solve visits),
 :mod:`~ur3hanoi.labfile.format` (the text of numbers and keys), :mod:`~ur3hanoi.labfile.splice` (replacing keys in
-the file's text), :mod:`~ur3hanoi.labfile.update` (the locked atomic update, NumPy-free) and
-:mod:`~ur3hanoi.labfile.unchanged` (files known to hold their keys already), :mod:`~ur3hanoi.labfile.write` (a
-generated table's keys, then the update) and :mod:`~ur3hanoi.labfile.generated` (a generated key through the user's
-cache). A name is imported from its module on first use (the package itself imports none), so what needs no NumPy
-does not load it.
+the file's text), :mod:`~ur3hanoi.labfile.sections` (generated keys ready to write), :mod:`~ur3hanoi.labfile.update`
+(the locked atomic update, NumPy-free), :mod:`~ur3hanoi.labfile.unchanged` (files known to hold their keys
+already), :mod:`~ur3hanoi.labfile.write` (a generated table's keys, then the update) and
+:mod:`~ur3hanoi.labfile.generated` (a generated key through the user's cache). A name is imported from its module
+on first use (the package itself imports none), so what needs no NumPy does not load it.
 """
 
 from __future__ import annotations
@@ -58,8 +58,9 @@ if TYPE_CHECKING:
         recorded_table_of,
         table_of,
     )
+    from ur3hanoi.labfile.sections import Sections
     from ur3hanoi.labfile.splice import splice_yaml
-    from ur3hanoi.labfile.update import Sections, write_sections
+    from ur3hanoi.labfile.update import write_sections
     from ur3hanoi.labfile.visits import entries_visited, entry_label, missing_entries, require_entries
     from ur3hanoi.labfile.write import table_sections, write_table
 
@@ -69,7 +70,8 @@ _MODULE_OF: dict[str, str] = {
     **dict.fromkeys(("LAB_FILE_SCHEMA", "RecordedTable", "Slot", "lab_key", "parse_q", "read_recorded_table",
                      "read_table", "recorded_table_of", "table_of"), "read"),
     "splice_yaml": "splice",
-    **dict.fromkeys(("Sections", "write_sections"), "update"),
+    "Sections": "sections",
+    "write_sections": "update",
     **dict.fromkeys(("entries_visited", "entry_label", "missing_entries", "require_entries"), "visits"),
     **dict.fromkeys(("table_sections", "write_table"), "write"),
 }

@@ -5,7 +5,7 @@ Generating a key (read the station, IK of every grid pose, format the text) cost
 costs more than the rest of the command. :func:`generate_key` keeps what the command writes and prints:
 
 - **Value** (:class:`GeneratedKey`): the keys' text with their provenance comments and values
-  (:class:`~ur3hanoi.labfile.update.Sections`: the table key, and ``block_xy_pos`` for a flat layout), and the
+  (:class:`~ur3hanoi.labfile.sections.Sections`: the table key, and ``block_xy_pos`` for a flat layout), and the
   numbers the command prints (towers, heights, largest IK errors, poses refined).
 - **Key**: the calibration file's bytes (a shipped station's own file for its name; never the file's name or time
   stamp), the table key, the IK solver, the joint convention, the label the provenance comment names the
@@ -31,7 +31,7 @@ from ur3hanoi.cache import cached, installed_versions, source_digest
 from ur3hanoi.errors import CalibrationError, InputError
 from ur3hanoi.io.reading import read_input_bytes
 from ur3hanoi.labfile.file import check_key
-from ur3hanoi.labfile.update import Sections
+from ur3hanoi.labfile.sections import Sections
 from ur3hanoi.resources import station_file
 
 GENERATED_KEY = "tables-key"
@@ -47,7 +47,7 @@ LIBRARIES: tuple[str, ...] = ("numpy", "pin", "placo", "example_robot_data", "py
 
 class GeneratedKey(NamedTuple):
     """A generated table key: what ``ur3hanoi tables`` writes and prints (a named tuple, like
-    :class:`~ur3hanoi.labfile.update.Sections`).
+    :class:`~ur3hanoi.labfile.sections.Sections`).
 
     Attributes:
         sections: the keys to write (:func:`~ur3hanoi.labfile.update.write_sections`).

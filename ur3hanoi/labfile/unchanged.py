@@ -8,7 +8,7 @@ only confirms what the last run found. :func:`~ur3hanoi.labfile.update.write_sec
 of the same keys into a file of the same bytes (:func:`holds`) writes them back unparsed, which is what the full
 path writes.
 
-- **Key**: the file's bytes (by their sha256), every field of the :class:`~ur3hanoi.labfile.update.Sections`
+- **Key**: the file's bytes (by their sha256), every field of the :class:`~ur3hanoi.labfile.sections.Sections`
   written (text, provenance lines, values), the source of the ``labfile`` and ``io`` packages (the reading, splice
   and read-back check) and the PyYAML and Python versions: a file differing in one byte, other keys, another
   reader or splice is a new entry, and goes through the full read and check.
@@ -22,12 +22,9 @@ import hashlib
 import json
 import sys
 from collections.abc import Iterable
-from typing import TYPE_CHECKING
 
 from ur3hanoi import cache
-
-if TYPE_CHECKING:
-    from ur3hanoi.labfile.update import Sections
+from ur3hanoi.labfile.sections import Sections
 
 UNCHANGED = "lab-file-unchanged"
 """Kind of the cache entries of this module."""

@@ -1,21 +1,22 @@
 """Writing generated keys into a lab table file: the locked read-modify-write that ends in an atomic replace.
 
-:func:`write_sections` takes the keys' text as already formatted (:class:`Sections`) and is NumPy-free, so that
-``ur3hanoi tables`` with its generated key in the user's cache imports no numerical library. Under the output's lock
-(:func:`ur3hanoi.io.atomic.locked_output`, so concurrent writers of different keys never lose one) it reads the file
-(strict YAML, its top level a mapping: anything else is refused and the file left byte-identical), splices the keys
-in (:mod:`~ur3hanoi.labfile.splice`: every other byte kept), checks that the result reads back (every other key as
-it was, the written keys as generated) and replaces the file atomically; a byte-order mark is kept. A file found to
-hold the keys already is remembered in the user's cache (:mod:`~ur3hanoi.labfile.unchanged`): the same keys written
-into the same bytes again are written back without PyYAML (imported only when a file is parsed).
+:func:`write_sections` takes the keys' text as already formatted (:class:`~ur3hanoi.labfile.sections.Sections`)
+and is NumPy-free, so that ``ur3hanoi tables`` with its generated key in the user's cache imports no numerical
+library. Under the output's lock (:func:`ur3hanoi.io.atomic.locked_output`, so concurrent writers of different keys
+never lose one) it reads the file (strict YAML, its top level a mapping: anything else is refused and the file left
+byte-identical), splices the keys in (:mod:`~ur3hanoi.labfile.splice`: every other byte kept), checks that the
+result reads back (every other key as it was, the written keys as generated) and replaces the file atomically; a
+byte-order mark is kept. A file found to hold the keys already is remembered in the user's cache
+(:mod:`~ur3hanoi.labfile.unchanged`): the same keys written into the same bytes again are written back without
+PyYAML (imported only when a file is parsed).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any
 
 from ur3hanoi.errors import TableError, printable
 from ur3hanoi.io.atomic import locked_output
@@ -23,25 +24,7 @@ from ur3hanoi.io.reading import read_input_bytes
 from ur3hanoi.labfile import unchanged
 from ur3hanoi.labfile.file import WHAT, LabFile, check_key, parse_lab_file
 from ur3hanoi.labfile.format import ANGLE_DECIMALS
-
-
-class Sections(NamedTuple):
-    """Keys of a lab table file as ur3hanoi generated them, ready to be written (a named tuple: it is created on
-    every ``tables`` run, and a frozen dataclass costs a millisecond to define).
-
-    Attributes:
-        key: the table key they are for (``sim_pos`` or ``real_pos``; named in messages).
-        text: key -> block-YAML text of ``key: value`` (unindented, ending in a newline), in the order new keys are
-            added; the table key first, then ``block_xy_pos`` for a flat layout.
-        headers: key -> its provenance comment line (no newline), written on the line above the key.
-        values: key -> the value as nested lists of floats [rad or m]: what the text reads back as (within
-            ``10**-ANGLE_DECIMALS``), and what a file whose top-level mapping is in flow style gets.
-    """
-
-    key: str
-    text: Mapping[str, str]
-    headers: Mapping[str, str]
-    values: Mapping[str, Any]
+from ur3hanoi.labfile.sections import Sections
 
 
 def write_sections(path: str | Path, sections: Sections, inputs: Sequence[str | Path] = ()) -> str:
@@ -138,4 +121,4 @@ def _check_read_back(text: str, old: LabFile, sections: Sections, shown: str) ->
             raise refuse(f"'{k}' does not read back")
 
 
-__all__ = ["Sections", "write_sections"]
+__all__ = ["write_sections"]

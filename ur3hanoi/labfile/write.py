@@ -17,7 +17,8 @@ from ur3hanoi.errors import printable
 from ur3hanoi.grid import block_xy_pos
 from ur3hanoi.labfile.file import BLOCK_XY_KEY, check_key
 from ur3hanoi.labfile.format import format_q, format_xy
-from ur3hanoi.labfile.update import Sections, write_sections
+from ur3hanoi.labfile.sections import Sections
+from ur3hanoi.labfile.update import write_sections
 from ur3hanoi.resources import station_file
 from ur3hanoi.waypoints import Table
 
