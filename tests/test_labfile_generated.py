@@ -247,3 +247,23 @@ def test_the_key_covers_every_module_a_run_imports(tmp_path: Path) -> None:
     assert {Path("ik.py"), Path("station.py"), Path("labfile/write.py")} <= modules  # it was a cold run
     folders = {"" if len(m.parts) == 1 else m.parts[0] for m in modules}
     assert folders <= set(SOURCE_FOLDERS), sorted(str(m) for m in modules)
+
+
+def test_a_calibration_changed_while_it_is_read_is_not_kept(tmp_path: Path, private_cache: Path,
+                                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    """The key's inputs hold the bytes read first; a station loaded from other bytes (the file edited meanwhile)
+    gives its own key to this run but no entry under the first bytes' key."""
+    calibration = tmp_path / "station.yaml"
+    calibration.write_text(LAB_SIM.read_text())
+    moved = LAB_SIM.read_text().replace("origin: [0.40, 0.05, 0.0125]", "origin: [0.41, 0.05, 0.0125]")
+
+    def edited_meanwhile(path: object) -> object:
+        calibration.write_text(moved)
+        return load_station(path)  # type: ignore[arg-type]
+
+    with monkeypatch.context() as m:
+        m.setattr("ur3hanoi.station.load_station", edited_meanwhile)
+        got = generate_key(str(calibration), "sim_pos")
+    assert _entries(private_cache) == []
+    fresh = generate_key(str(calibration), "sim_pos")  # now a miss on the new bytes, kept
+    assert got.sections == fresh.sections and len(_entries(private_cache)) == 1

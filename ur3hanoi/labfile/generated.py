@@ -17,12 +17,15 @@ costs more than the rest of the command. :func:`generate_key` keeps what the com
   not decode to a :class:`GeneratedKey` is rebuilt, and a cache that cannot be written only costs the rebuild).
 - **Errors**: a calibration that cannot be read or is invalid is never kept, so it fails with the same message
   whether anything is cached or not; the output file is checked by the write (:func:`write_sections`), every time.
+  A key generated from other bytes than those of its entry's key (the calibration changed while it was read) is
+  not kept.
 
 Computing the key reads the calibration and the modules' files only: it imports no numerical library.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import sys
 from typing import Any, NamedTuple
@@ -57,6 +60,7 @@ class GeneratedKey(NamedTuple):
         refined: how many poses the IK refiner (``solver``) improved on the closed form.
         n_poses: how many poses the table has (towers x heights x 2).
         solver: the IK refiner.
+        calibration_sha256: hex digest of the calibration file's bytes the key was generated from.
     """
 
     sections: Sections
@@ -67,6 +71,7 @@ class GeneratedKey(NamedTuple):
     refined: int
     n_poses: int
     solver: str
+    calibration_sha256: str
 
 
 def generate_key(calibration: str, key: str, solver: str = "pinocchio", convention: str = "controller",
@@ -98,7 +103,16 @@ def generate_key(calibration: str, key: str, solver: str = "pinocchio", conventi
         return build()
     inputs = [raw, key.encode(), solver.encode(), convention.encode(), label.encode(),
               source_digest(SOURCE_FOLDERS), repr((installed_versions(LIBRARIES), sys.version)).encode()]
-    return cached(GENERATED_KEY, inputs, build, _encode, _decode)
+    digest = hashlib.sha256(raw).hexdigest()
+
+    def encode(value: GeneratedKey) -> bytes | None:  # kept only if made from the bytes of the key
+        return _encode(value) if value.calibration_sha256 == digest else None
+
+    def decode(payload: bytes) -> GeneratedKey | None:
+        value = _decode(payload)
+        return value if value is not None and value.calibration_sha256 == digest else None
+
+    return cached(GENERATED_KEY, inputs, build, encode, decode)
 
 
 def _generate(calibration: str, key: str, solver: str, convention: str, label: str) -> GeneratedKey:
@@ -112,7 +126,8 @@ def _generate(calibration: str, key: str, solver: str, convention: str, label: s
         sections=table_sections(table, key, label, convention), n_towers=station.n_towers,
         n_heights=station.n_heights, max_position_error=float(table.max_position_error),
         max_orientation_error=float(table.max_orientation_error),
-        refined=sum(r.iterations > 0 for r in table.results), n_poses=len(table.results), solver=table.solver)
+        refined=sum(r.iterations > 0 for r in table.results), n_poses=len(table.results), solver=table.solver,
+        calibration_sha256=station.sha256)
 
 
 def _encode(value: GeneratedKey) -> bytes | None:
@@ -123,6 +138,7 @@ def _encode(value: GeneratedKey) -> bytes | None:
             "n_towers": value.n_towers, "n_heights": value.n_heights,
             "max_position_error": value.max_position_error, "max_orientation_error": value.max_orientation_error,
             "refined": value.refined, "n_poses": value.n_poses, "solver": value.solver,
+            "calibration_sha256": value.calibration_sha256,
         }, allow_nan=False).encode()
     except (TypeError, ValueError):  # a value JSON cannot hold exactly: not kept
         return None
@@ -148,13 +164,14 @@ def _decode(payload: bytes) -> GeneratedKey | None:
     ok = (isinstance(sec["key"], str) and _strings(text) and _strings(headers) and isinstance(values, dict)
           and sec["key"] in text and set(values) == set(text) and set(headers) <= set(text)
           and all(_numbers(v) for v in values.values()) and isinstance(data["solver"], str)
+          and isinstance(data["calibration_sha256"], str)
           and all(type(n) is int and n >= 0 for n in ints) and all(isinstance(e, float) for e in errors))
     if not ok:
         return None
     return GeneratedKey(
         sections=Sections(key=sec["key"], text=text, headers=headers, values=values), n_towers=ints[0],
         n_heights=ints[1], max_position_error=errors[0], max_orientation_error=errors[1], refined=ints[2],
-        n_poses=ints[3], solver=data["solver"])
+        n_poses=ints[3], solver=data["solver"], calibration_sha256=data["calibration_sha256"])
 
 
 __all__ = ["GENERATED_KEY", "GeneratedKey", "generate_key"]
