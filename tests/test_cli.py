@@ -316,6 +316,7 @@ def _raise(exc: BaseException) -> object:
 def test_suction_fault_exits_3(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
                                capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.setattr("ur3hanoi.waypoints.generate_table", _raise(SuctionFaultError("block 2 is not held")))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))  # nothing cached: tables generates its key
     assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(tmp_path / "t.yaml")]) == 3
     assert _one_error_line(capsys.readouterr().err) == "ur3hanoi: error: block 2 is not held\n"
 
@@ -323,6 +324,7 @@ def test_suction_fault_exits_3(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
 def test_unexpected_exception_is_one_line_exit_70(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
                                                   capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.setattr("ur3hanoi.waypoints.generate_table", _raise(ZeroDivisionError("float division\nby zero")))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))  # nothing cached: tables generates its key
     argv = ["tables", "lab_sim", "--key", "sim_pos", "-o", str(tmp_path / "t.yaml")]
     assert main(argv) == 70
     err = _one_error_line(capsys.readouterr().err)
@@ -338,6 +340,7 @@ def test_unexpected_exception_is_one_line_exit_70(monkeypatch: pytest.MonkeyPatc
 def test_keyboard_interrupt_exits_130(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
                                       capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.setattr("ur3hanoi.waypoints.generate_table", _raise(KeyboardInterrupt()))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))  # nothing cached: tables generates its key
     assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(tmp_path / "t.yaml")]) == 130
     assert capsys.readouterr().err == "ur3hanoi tables: interrupted\n"
 

@@ -101,14 +101,39 @@ print(json.dumps([code, sorted(m for m in sys.modules if m.split(".")[0] in {hea
 """
 
 
-def test_tables_on_a_shipped_station_needs_no_pinocchio(tmp_path: Path) -> None:
+_TABLES_PROBE = """
+import contextlib, io, json, sys
+import ur3hanoi.cli
+with contextlib.redirect_stdout(io.StringIO()):
+    code = ur3hanoi.cli.main({argv!r})
+print(json.dumps([code, sorted(m for m in sys.modules if m.split(".")[0] in {heavy!r}
+                               or m in ("ur3hanoi.ik", "ur3hanoi.waypoints", "ur3hanoi.station"))]))
+"""
+
+
+def test_tables_needs_no_pinocchio_and_from_the_user_cache_no_numpy(tmp_path: Path) -> None:
     """The closed form solves every pose of a shipped station within 1e-9 m / rad, measured by the NumPy FK of the
-    URDF chain: ``tables`` imports neither Pinocchio (nor coal, placo) nor anything else heavy but NumPy and YAML."""
+    URDF chain: a first ``tables`` imports neither Pinocchio (nor coal, placo) nor anything else heavy but NumPy
+    and YAML. The next one on the same calibration takes its key from the user's cache: YAML only (to read the
+    output file), no NumPy, no station, IK or waypoint module. It finds the file holding its key already, so the
+    one after writes it back without YAML either (ur3hanoi.labfile.unchanged)."""
+    import os
+
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "xdg")}
     for station, key in (("lab_sim", "sim_pos"), ("lab_real", "real_pos")):
-        argv = ["tables", station, "--key", key, "-o", str(tmp_path / "lab2_data.yaml")]
-        code, loaded = _probe(_RUN_PROBE.format(argv=argv, heavy=HEAVY))  # type: ignore[misc]
-        assert code == 0
-        assert {m.split(".")[0] for m in loaded} == {"numpy", "yaml"}, loaded
+        argv = ["tables", station, "--key", key, "-o", str(tmp_path / f"{station}.yaml")]
+        runs = []
+        for _ in range(3):
+            proc = subprocess.run([sys.executable, "-c", _TABLES_PROBE.format(argv=argv, heavy=HEAVY)],
+                                  capture_output=True, text=True, cwd=REPO, timeout=120, env=env)
+            assert proc.returncode == 0, proc.stderr
+            runs.append(json.loads(proc.stdout))
+        assert [code for code, _ in runs] == [0, 0, 0]
+        first, hit, unchanged = (loaded for _, loaded in runs)
+        assert {m.split(".")[0] for m in first} == {"numpy", "yaml", "ur3hanoi"}, first
+        assert {"ur3hanoi.ik", "ur3hanoi.waypoints", "ur3hanoi.station"} <= set(first)  # the probe sees them
+        assert {m.split(".")[0] for m in hit} == {"yaml"}, hit
+        assert unchanged == [], unchanged
 
 
 def test_a_plan_from_the_user_cache_needs_no_pinocchio_coal_or_scipy(tmp_path: Path) -> None:

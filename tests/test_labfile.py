@@ -550,3 +550,15 @@ def test_for_solve_needs_the_visited_entries_only(tmp_path: Path) -> None:
                                          r"height 2 on \(Q\[0\]\[1\]\[0\]\); tower 1 height 2 above .*; tower 2 "
                                          r"height 1 above \(Q\[1\]\[0\]\[1\]\)$"):
         rec.for_solve(0, 2, 2)
+
+
+def test_every_public_name_resolves_from_its_module() -> None:
+    """The package imports its modules on first use (ur3hanoi.labfile.__getattr__): every name of __all__ is there,
+    and an unknown one is an AttributeError."""
+    import ur3hanoi.labfile as labfile
+
+    for name in labfile.__all__:
+        assert getattr(labfile, name) is not None, name
+    assert set(labfile.__all__) <= set(dir(labfile))
+    with pytest.raises(AttributeError, match="no attribute 'nope'"):
+        labfile.nope  # noqa: B018

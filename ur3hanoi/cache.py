@@ -21,11 +21,11 @@ from __future__ import annotations
 import base64
 import binascii
 import contextlib
+import functools
 import hashlib
 import json
 import os
 import re
-import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, TypeVar
@@ -126,6 +126,29 @@ def installed_versions(names: Iterable[str]) -> tuple[tuple[str, str | None], ..
     return tuple((n, found.get(n)) for n in wanted)
 
 
+_PACKAGE = Path(__file__).resolve().parent  # ur3hanoi/
+
+
+def source_digest(folders: Iterable[str]) -> bytes:
+    """sha256 of ur3hanoi's own modules in ``folders`` (relative to the package: ``""`` the top-level modules,
+    ``"io"`` that package with its subpackages), each by its path and content: a key input for what that code
+    computes. Each folder is read once per process."""
+    h = hashlib.sha256()
+    for folder in folders:
+        h.update(_folder_digest(folder))
+    return h.digest()
+
+
+@functools.lru_cache(maxsize=16)
+def _folder_digest(folder: str) -> bytes:
+    h = hashlib.sha256()
+    root = _PACKAGE / folder
+    for path in sorted(root.rglob("*.py") if folder else root.glob("*.py")):
+        h.update(path.relative_to(_PACKAGE).as_posix().encode() + b"\0")
+        h.update(hashlib.sha256(path.read_bytes()).digest())
+    return h.digest()
+
+
 T = TypeVar("T")
 
 
@@ -201,6 +224,8 @@ def collision_geometry(robot: Ur3Model, build: Callable[[], pin.GeometryModel]) 
 @contextlib.contextmanager
 def _scratch_file() -> Iterator[Path]:
     """A private temporary file path (Pinocchio serializes to and from files only), removed afterwards."""
+    import tempfile  # imported here: only the collision geometry needs it
+
     fd, name = tempfile.mkstemp(prefix="ur3hanoi-", suffix=".bin")
     os.close(fd)
     try:

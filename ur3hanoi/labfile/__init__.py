@@ -24,42 +24,72 @@ uses it. :meth:`RecordedTable.for_solve` is the rule of the table followers (``s
 entries.
 
 Writing (:func:`write_table`) replaces one key's text and keeps every other byte of the file (see
-:mod:`~ur3hanoi.labfile.write`); angles are written with :data:`ANGLE_DECIMALS` decimals so the file is the same on
+:mod:`~ur3hanoi.labfile.splice`); angles are written with :data:`ANGLE_DECIMALS` decimals so the file is the same on
 every CPU; the read-modify-write holds a lock and ends in an atomic replace (:mod:`ur3hanoi.io.atomic`), so
-concurrent writers of different keys never lose one.
+concurrent writers of different keys never lose one. :func:`write_sections` writes keys already formatted
+(:class:`Sections`, e.g. kept in the user's cache) and needs no NumPy.
 
-Module map: :mod:`~ur3hanoi.labfile.read` (schema, reading a key, :class:`RecordedTable`),
-:mod:`~ur3hanoi.labfile.visits` (the entries a solve visits) and :mod:`~ur3hanoi.labfile.write` (formatting a key,
-splicing it into the file, the locked atomic update).
+Module map: :mod:`~ur3hanoi.labfile.file` (the keys, reading the file as a mapping), :mod:`~ur3hanoi.labfile.read`
+(schema, reading a key, :class:`RecordedTable`), :mod:`~ur3hanoi.labfile.visits` (the entries a solve visits),
+:mod:`~ur3hanoi.labfile.format` (the text of numbers and keys), :mod:`~ur3hanoi.labfile.splice` (replacing keys in
+the file's text), :mod:`~ur3hanoi.labfile.sections` (generated keys ready to write), :mod:`~ur3hanoi.labfile.update`
+(the locked atomic update, NumPy-free), :mod:`~ur3hanoi.labfile.unchanged` (files known to hold their keys
+already), :mod:`~ur3hanoi.labfile.write` (a generated table's keys, then the update) and
+:mod:`~ur3hanoi.labfile.generated` (a generated key through the user's cache). A name is imported from its module
+on first use (the package itself imports none), so what needs no NumPy does not load it.
 """
 
 from __future__ import annotations
 
-from ur3hanoi.labfile.read import (
-    BLOCK_XY_KEY,
-    LAB_FILE_SCHEMA,
-    TABLE_KEYS,
-    LabFile,
-    RecordedTable,
-    Slot,
-    lab_key,
-    parse_q,
-    read_lab_file,
-    read_recorded_table,
-    read_table,
-    recorded_table_of,
-    table_of,
-)
-from ur3hanoi.labfile.visits import entries_visited, entry_label, missing_entries, require_entries
-from ur3hanoi.labfile.write import (
-    ANGLE_DECIMALS,
-    FILE_HEADER,
-    format_number,
-    format_q,
-    format_xy,
-    splice_yaml,
-    write_table,
-)
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from ur3hanoi.labfile.file import BLOCK_XY_KEY, TABLE_KEYS, LabFile, read_lab_file
+    from ur3hanoi.labfile.format import ANGLE_DECIMALS, FILE_HEADER, format_number, format_q, format_xy
+    from ur3hanoi.labfile.read import (
+        LAB_FILE_SCHEMA,
+        RecordedTable,
+        Slot,
+        lab_key,
+        parse_q,
+        read_recorded_table,
+        read_table,
+        recorded_table_of,
+        table_of,
+    )
+    from ur3hanoi.labfile.sections import Sections
+    from ur3hanoi.labfile.splice import splice_yaml
+    from ur3hanoi.labfile.update import write_sections
+    from ur3hanoi.labfile.visits import entries_visited, entry_label, missing_entries, require_entries
+    from ur3hanoi.labfile.write import table_sections, write_table
+
+_MODULE_OF: dict[str, str] = {
+    **dict.fromkeys(("BLOCK_XY_KEY", "TABLE_KEYS", "LabFile", "read_lab_file"), "file"),
+    **dict.fromkeys(("ANGLE_DECIMALS", "FILE_HEADER", "format_number", "format_q", "format_xy"), "format"),
+    **dict.fromkeys(("LAB_FILE_SCHEMA", "RecordedTable", "Slot", "lab_key", "parse_q", "read_recorded_table",
+                     "read_table", "recorded_table_of", "table_of"), "read"),
+    "splice_yaml": "splice",
+    "Sections": "sections",
+    "write_sections": "update",
+    **dict.fromkeys(("entries_visited", "entry_label", "missing_entries", "require_entries"), "visits"),
+    **dict.fromkeys(("table_sections", "write_table"), "write"),
+}
+"""The module of this package that defines each public name."""
+
+
+def __getattr__(name: str) -> Any:
+    module = _MODULE_OF.get(name)
+    if module is None:
+        raise AttributeError(f"module 'ur3hanoi.labfile' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"ur3hanoi.labfile.{module}"), name)
+    globals()[name] = value  # found directly from now on
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})
+
 
 __all__ = [
     "ANGLE_DECIMALS",
@@ -69,6 +99,7 @@ __all__ = [
     "TABLE_KEYS",
     "LabFile",
     "RecordedTable",
+    "Sections",
     "Slot",
     "entries_visited",
     "entry_label",
@@ -85,5 +116,7 @@ __all__ = [
     "require_entries",
     "splice_yaml",
     "table_of",
+    "table_sections",
+    "write_sections",
     "write_table",
 ]

@@ -1,6 +1,8 @@
-"""Reading a lab table file: the schema, strict reading, and tables as recorded (:class:`RecordedTable`).
+"""Reading a lab table file's keys: the schema, strict reading of one key, and tables as recorded
+(:class:`RecordedTable`).
 
-See :mod:`ur3hanoi.labfile` for the format and what a recorded table may leave out.
+See :mod:`ur3hanoi.labfile` for the format and what a recorded table may leave out; reading the file as a mapping of
+keys is :mod:`~ur3hanoi.labfile.file`'s (its names are re-exported here).
 """
 
 from __future__ import annotations
@@ -14,19 +16,15 @@ import numpy as np
 import numpy.typing as npt
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.errors import TableError, printable, quote
+from ur3hanoi.errors import TableError, printable
 from ur3hanoi.hanoi import solve_hanoi, validate_instance
-from ur3hanoi.io.schema import Field, ListOf, Nullable, Number, Record, Spec, Vector, describe_type, suggest
+from ur3hanoi.io.schema import Field, ListOf, Nullable, Number, Record, Spec, Vector, suggest
 from ur3hanoi.io.schema import validate as validate_schema
-from ur3hanoi.io.yaml_loader import load_yaml_file
+from ur3hanoi.labfile.file import BLOCK_XY_KEY, TABLE_KEYS, WHAT, LabFile, check_key, read_lab_file
 from ur3hanoi.labfile.visits import require_entries
 from ur3hanoi.robot import N_JOINTS
 from ur3hanoi.station import MAX_HEIGHTS, MAX_TOWERS
 from ur3hanoi.waypoints import pose_label
-
-TABLE_KEYS: tuple[str, ...] = ("sim_pos", "real_pos")
-BLOCK_XY_KEY = "block_xy_pos"
-WHAT = "lab table file"
 
 JOINT_ANGLE = Number(-2 * math.pi, 2 * math.pi, unit="rad", what="a joint angle")
 Q_SCHEMA: Spec = ListOf(
@@ -52,17 +50,6 @@ LAB_FILE_SCHEMA = Record({
 """The lab table file's schema: a mapping; ur3hanoi's three keys, each optional; any other key is the student's
 and may hold anything. A reader checks only the key it reads (:func:`lab_key`): a malformed ``real_pos`` does not
 stop anyone from reading ``sim_pos``."""
-
-
-@dataclass(frozen=True)
-class LabFile:
-    """A lab table file whose top level is a mapping: ``data`` (key -> value, not checked), its ``text`` (without
-    a byte-order mark; ``bom`` says whether the file had one) and the sha256 of its bytes."""
-
-    data: dict[Any, Any]
-    text: str
-    sha256: str
-    bom: bool = False
 
 
 def lab_key(data: dict[Any, Any], key: str, source: str) -> Any:
@@ -94,22 +81,6 @@ def _check_rectangular(value: list[Any], source: str, key: str) -> None:
             raise TableError.invalid(source, f"{key}[{t}]", tower,
                                      f"{len(first)} heights like {key}[{t0}] (every tower has the same number of "
                                      "heights)")
-
-
-def read_lab_file(path: str | Path, source: str | None = None) -> LabFile:
-    """Read a lab table file (strict YAML); ``source`` names it in messages. Only the top level is checked (a
-    mapping, or an empty file): each key is checked when it is read (:func:`lab_key`).
-
-    Raises:
-        TableError: unreadable, not strict YAML, or its top level is not a mapping; the message names the file.
-    """
-    source = str(path) if source is None else source
-    doc = load_yaml_file(path, what=WHAT, error=TableError, source=source)
-    data = {} if doc.data is None else doc.data
-    if not isinstance(data, dict):
-        raise TableError.file(source, f"the top level is {describe_type(data)}, not a mapping of keys "
-                                      f"({', '.join(LAB_FILE_SCHEMA.fields)}, or your own): not a {WHAT}")
-    return LabFile(data=data, text=doc.text, sha256=doc.sha256, bom=doc.bom)
 
 
 def parse_q(value: Any, source: str, key: str) -> FloatArray:
@@ -249,12 +220,6 @@ def read_table(path: str | Path, key: str) -> FloatArray:
         TableError: the file is invalid (see :func:`read_lab_file`), has no ``key``, or misses entries (named).
     """
     return table_of(read_lab_file(path), path, key)
-
-
-def check_key(key: str) -> None:
-    """Refuse a table key other than :data:`TABLE_KEYS`."""
-    if key not in TABLE_KEYS:
-        raise TableError(f"table key {quote(key)} is invalid: expected one of {', '.join(TABLE_KEYS)}")
 
 
 def table_of(lab: LabFile, path: str | Path, key: str) -> FloatArray:
