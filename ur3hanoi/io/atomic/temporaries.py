@@ -7,7 +7,6 @@ import fcntl
 import hashlib
 import os
 import re
-import secrets
 import shutil
 import stat
 from pathlib import Path
@@ -35,7 +34,7 @@ def _host_tag() -> str:
 
 def temporary_name(suffix: str = ".tmp") -> str:
     """A fresh temporary name ``.ur3hanoi-<pid>-<host>-<random><suffix>`` (under 50 bytes, whatever the target)."""
-    return f"{TEMP_PREFIX}{os.getpid()}-{_host_tag()}-{secrets.token_hex(4)}{suffix}"
+    return f"{TEMP_PREFIX}{os.getpid()}-{_host_tag()}-{os.urandom(4).hex()}{suffix}"
 
 
 def lock_file_name(name: str) -> str:
