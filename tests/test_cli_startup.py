@@ -115,7 +115,7 @@ def test_tables_needs_no_pinocchio_and_from_the_user_cache_no_numpy(tmp_path: Pa
     """The closed form solves every pose of a shipped station within 1e-9 m / rad, measured by the NumPy FK of the
     URDF chain: a first ``tables`` imports neither Pinocchio (nor coal, placo) nor anything else heavy but NumPy
     and YAML. The next one on the same calibration takes its key from the user's cache: YAML only (to read the
-    output file), no NumPy, no station, IK or waypoint module. It finds the file holding its key already, so the
+    output file), no NumPy, no station, IK or waypoint module, no dataclasses. It finds the file holding its key already, so the
     one after writes it back without YAML either (ur3hanoi.labfile.unchanged)."""
     import os
 
@@ -124,13 +124,13 @@ def test_tables_needs_no_pinocchio_and_from_the_user_cache_no_numpy(tmp_path: Pa
         argv = ["tables", station, "--key", key, "-o", str(tmp_path / f"{station}.yaml")]
         runs = []
         for _ in range(3):
-            proc = subprocess.run([sys.executable, "-c", _TABLES_PROBE.format(argv=argv, heavy=HEAVY)],
+            proc = subprocess.run([sys.executable, "-c", _TABLES_PROBE.format(argv=argv, heavy=HELP_UNUSED)],
                                   capture_output=True, text=True, cwd=REPO, timeout=120, env=env)
             assert proc.returncode == 0, proc.stderr
             runs.append(json.loads(proc.stdout))
         assert [code for code, _ in runs] == [0, 0, 0]
         first, hit, unchanged = (loaded for _, loaded in runs)
-        assert {m.split(".")[0] for m in first} == {"numpy", "yaml", "ur3hanoi"}, first
+        assert {m.split(".")[0] for m in first} == {"numpy", "yaml", "ur3hanoi", "dataclasses", "inspect"}, first
         assert {"ur3hanoi.ik", "ur3hanoi.waypoints", "ur3hanoi.station"} <= set(first)  # the probe sees them
         assert {m.split(".")[0] for m in hit} == {"yaml"}, hit
         assert unchanged == [], unchanged

@@ -1,8 +1,9 @@
 """Files shipped inside the package: the MuJoCo UR3 robot folder and the station calibrations.
 
-Everything is found through :mod:`importlib.resources`, never through the working directory or the source tree,
-so an installed wheel finds the same files as a checkout. MuJoCo and the YAML loader need real files, so the
-package must be installed unzipped (what pip does for wheels).
+Everything is found beside this module, in the package's own folder, never through the working directory, so an
+installed wheel finds the same files as a checkout. MuJoCo and the YAML loader need real files, so the package must
+be installed unzipped (what pip does for wheels); for such a package :func:`importlib.resources.files` is this same
+folder, and importing it would cost every command that reads a station 4-5 ms (it loads zipfile and threading).
 
 Shipped stations are addressable by name wherever a calibration file is accepted: ``lab_sim`` (the course's
 flat Gazebo layout) and ``lab_real`` (an example stacked station); see ``ur3hanoi/stations/README.md``.
@@ -10,7 +11,6 @@ flat Gazebo layout) and ``lab_real`` (an example stacked station); see ``ur3hano
 
 from __future__ import annotations
 
-from importlib.resources import files
 from pathlib import Path
 
 ROBOT_NAME = "universal_robots_ur3"
@@ -20,8 +20,11 @@ TAUGHT_EXAMPLE = "taught_example.yaml"
 """An example taught-points file shipped beside the stations (not a station)."""
 
 
+_PACKAGE = Path(__file__).resolve().parent  # ur3hanoi/
+
+
 def _package_dir(*parts: str) -> Path:
-    return Path(str(files("ur3hanoi").joinpath(*parts)))
+    return _PACKAGE.joinpath(*parts)
 
 
 def robot_dir() -> Path:

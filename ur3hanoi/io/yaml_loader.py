@@ -24,9 +24,8 @@ from __future__ import annotations
 
 import codecs
 import hashlib
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import yaml
 from yaml.constructor import ConstructorError
@@ -144,10 +143,10 @@ BOM = "\ufeff"
 """The byte-order mark a UTF-8 file may start with (not part of :attr:`YamlFile.text`)."""
 
 
-@dataclass(frozen=True)
-class YamlFile:
+class YamlFile(NamedTuple):
     """A loaded YAML file: the parsed ``data``, the decoded ``text`` (without a byte-order mark), the sha256 of the
-    file's bytes, and whether it started with a UTF-8 byte-order mark (``bom``)."""
+    file's bytes, and whether it started with a UTF-8 byte-order mark (``bom``). (A NamedTuple: this module must not
+    import dataclasses, see :class:`~ur3hanoi.io.yaml11.Yaml11Reading`.)"""
 
     data: Any
     text: str
