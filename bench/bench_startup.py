@@ -22,6 +22,7 @@ import argparse
 import contextlib
 import os
 import platform
+import re
 import resource
 import statistics
 import subprocess
@@ -37,13 +38,21 @@ sys.path.insert(0, str(REPO))
 
 HELP_TARGET_S, PLAN_TARGET_S, TABLES_TARGET_S, TABLE_IK_TARGET_MS = 0.08, 0.30, 0.12, 1.0
 
-STUDENT_FILE = """\
+STUDENT_HEAD = """\
 # Lab 2 waypoints (mine)
 home_pos: [0.0, -1.5708, 0.0, -1.5708, 0.0, 0.0]
 sim_pos: old  # to be regenerated
 notes:
   - recorded on station 4
 """
+
+
+def student_file() -> str:
+    """A student's lab file: keys of their own, a stale ``sim_pos`` and the shipped ``real_pos`` (18 poses)."""
+    shipped = (REPO / "tables" / "lab2_data.yaml").read_text(encoding="utf-8")
+    start = re.search(r"^# ur3hanoi [^\n]*: real_pos ", shipped, re.M)
+    assert start is not None, "tables/lab2_data.yaml has no real_pos"
+    return STUDENT_HEAD + shipped[start.start():]
 
 
 def machine() -> str:
@@ -205,13 +214,13 @@ def main() -> int:
               f"{first.wall:.3f} s, CPU {first.cpu:.3f} s")
         student = Path(tmp_name) / "student.yaml"
         argv = ["-m", "ur3hanoi", "tables", "lab_sim", "--key", "sim_pos", "-o", str(student)]
-        into_student = []
+        into_student, text = [], student_file()
         for _ in range(args.runs):  # a student's file with keys of their own and a stale key: read, spliced, checked
-            student.write_text(STUDENT_FILE)
+            student.write_text(text, encoding="utf-8")
             into_student.append(run.once(argv))
         print(f"ur3hanoi tables lab_sim --key sim_pos -o STUDENT_FILE: {summary(into_student, TABLES_TARGET_S)} "
-              "with its generated key in the user cache, into a student's file holding other keys and a stale "
-              "sim_pos (parsed, spliced, read back)")
+              f"with its generated key in the user cache, into a student's file ({len(text)} bytes: keys of their "
+              "own, a stale sim_pos and a real_pos table; parsed, spliced and read back)")
     for name in ("lab_sim", "lab_real"):
         for line in bench_ik_station(name, repeats=max(20, args.runs * 20)):
             print(line)

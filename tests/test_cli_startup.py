@@ -115,8 +115,8 @@ def test_tables_needs_no_pinocchio_and_from_the_user_cache_no_numpy(tmp_path: Pa
     """The closed form solves every pose of a shipped station within 1e-9 m / rad, measured by the NumPy FK of the
     URDF chain: a first ``tables`` imports neither Pinocchio (nor coal, placo) nor anything else heavy but NumPy
     and YAML. The next one on the same calibration takes its key from the user's cache: YAML only (to read the
-    output file), no NumPy, no station, IK or waypoint module, no dataclasses. It finds the file holding its key already, so the
-    one after writes it back without YAML either (ur3hanoi.labfile.unchanged)."""
+    output file), no NumPy, no station, IK or waypoint module, no dataclasses. It finds the file holding its key
+    already, so the one after writes it back without YAML either (ur3hanoi.labfile.unchanged)."""
     import os
 
     env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "xdg")}

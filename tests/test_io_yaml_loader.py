@@ -7,11 +7,12 @@ import hashlib
 from pathlib import Path
 
 import pytest
+import yaml
 
 from ur3hanoi.errors import CalibrationError, InputError
 from ur3hanoi.io.limits import MAX_ALIASES, MAX_DEPTH, MAX_INT_DIGITS, MAX_NODES
 from ur3hanoi.io.schema import Choice, Field, ListOf, Nullable, Number, Record, Text, validate
-from ur3hanoi.io.yaml_loader import Yaml11Reading, load_yaml_file, parse_yaml
+from ur3hanoi.io.yaml_loader import Yaml11Reading, load_yaml_file, parse_yaml, reparse_yaml
 
 
 def _laughs(levels: int) -> str:
@@ -165,3 +166,84 @@ def test_ambiguous_scalars_are_kept_where_anything_goes() -> None:
     validate(data, Record({"n": Field(Number())}, others=True), "f.yaml")
     assert data["mine"] == {"door": Yaml11Reading("010", 8, "the octal number 8", 2),
                             "lights": Yaml11Reading("on", True, "the boolean true", 2)}
+
+
+# --------------------------------------------------------------------------- reparse_yaml: the libyaml read-back
+
+_SHALLOW_HOSTILE = sorted(set(HOSTILE) - {"deep-flow", "deep-block"})  # libyaml composes recursively in C
+_DEPTH_EDGE = {
+    "deep-flow-just-over": ("[" * (MAX_DEPTH + 1) + "]" * (MAX_DEPTH + 1), f"nested deeper than {MAX_DEPTH} levels"),
+    "deep-block-just-over": ("".join(" " * i + f"k{i}:\n" for i in range(MAX_DEPTH)) + " " * MAX_DEPTH + "x\n",
+                             f"nested deeper than {MAX_DEPTH} levels"),
+}
+_READABLE = [
+    (REPO_TABLES := Path(__file__).resolve().parents[1] / "tables" / "lab2_data.yaml").read_text(encoding="utf-8"),
+    "base: &b {x: 1, y: 2}\nother:\n  <<: *b\n  y: 3\nlist: [*b, *b]\n",
+    "door: 010\nlights: on\ntime: 1:30\nangle: 1:30.5\nquoted: 'on'\nnull_value: ~\nempty:\n",
+    "# comment\nsim_pos:\n- - [0.1, -1.2, 3.0e-3, .5, -.inf, .nan]\n  - null\nnotes: |\n  two\n  lines\n"
+    "flow: {a: [1, 2], b: x}\n",
+    "[" * MAX_DEPTH + "]" * MAX_DEPTH,
+    "a: &a 1\nb: [" + ", ".join(["*a"] * MAX_ALIASES) + "]\n",
+    "[" + ", ".join(["0"] * (MAX_NODES - 1)) + "]",
+    "a: " + "9" * MAX_INT_DIGITS + "\n",
+    "",
+    "just a string\n",
+]
+
+
+def _same(a: object, b: object) -> bool:
+    """Equal parsed documents, NaN equal to NaN."""
+    if isinstance(a, float) and isinstance(b, float) and a != a and b != b:
+        return True
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, dict) and isinstance(b, dict):
+        return list(a) == list(b) and all(_same(a[k], b[k]) for k in a)
+    return type(a) is type(b) and a == b
+
+
+@pytest.mark.parametrize("index", range(len(_READABLE)))
+def test_reparse_reads_what_the_strict_loader_reads(index: int) -> None:
+    text = _READABLE[index]
+    assert _same(reparse_yaml(text, "f.yaml"), parse_yaml(text, "f.yaml"))
+
+
+@pytest.mark.parametrize("case", [*_SHALLOW_HOSTILE, *sorted(_DEPTH_EDGE)])
+def test_reparse_refuses_what_the_strict_loader_refuses_with_its_message(case: str) -> None:
+    text, match = HOSTILE.get(case) or _DEPTH_EDGE[case]
+    with pytest.raises(InputError, match=match) as strict:
+        parse_yaml(text, "evil.yaml")
+    with pytest.raises(InputError) as fast:
+        reparse_yaml(text, "evil.yaml")
+    assert str(fast.value) == str(strict.value)
+
+
+def test_the_graph_check_refuses_on_its_own() -> None:
+    """The limits hold in the libyaml path itself, not only through the strict loader's second reading: with the
+    strict loader replaced by one that accepts anything, a bomb, a cycle and deep nesting are still refused."""
+    import ur3hanoi.io.yaml_loader as loader
+
+    if not yaml.__with_libyaml__:
+        pytest.skip("PyYAML without libyaml: reparse_yaml is parse_yaml")
+    calls: list[str] = []
+
+    def accept(text: str, source: str, **_: object) -> str:
+        calls.append(text)
+        return "accepted by the fallback"
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(loader, "parse_yaml", accept)
+        for case in ("billion-laughs", "many-aliases", "recursive-alias", "many-nodes", "duplicate-key"):
+            assert loader.reparse_yaml(HOSTILE[case][0], "evil.yaml") == "accepted by the fallback", case
+        for text, _ in _DEPTH_EDGE.values():
+            assert loader.reparse_yaml(text, "evil.yaml") == "accepted by the fallback"
+        assert len(calls) == 7
+        assert loader.reparse_yaml(_READABLE[1], "ok.yaml") != "accepted by the fallback"
+        assert len(calls) == 7
+
+
+def test_reparse_without_libyaml_is_the_strict_loader(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(yaml, "__with_libyaml__", False)
+    assert _same(reparse_yaml(_READABLE[0], "f.yaml"), parse_yaml(_READABLE[0], "f.yaml"))
+    with pytest.raises(InputError, match="duplicate key"):
+        reparse_yaml(HOSTILE["duplicate-key"][0], "evil.yaml")

@@ -239,7 +239,11 @@ def test_readers_check_only_the_key_they_read(tmp_path: Path) -> None:
 
 STUDENT_FILE = """\
 # Lab 2, group 7: our own notes stay ours
-home_pos: [2.0944, -1.5708, 1.5708, -1.5708, -1.5708, 0.0]   # radians(120, -90, 90, -90, -90, 0)
+home_pos: &home [2.0944, -1.5708, 1.5708, -1.5708, -1.5708, 0.0]   # radians(120, -90, 90, -90, -90, 0)
+station:   # YAML 1.1 reads these as 8, True and 90: kept as the student wrote them
+  door: 010
+  lights: on
+  slot: 1:30
 
 sim_pos: old   # to be regenerated
 # notes about the station
@@ -247,6 +251,7 @@ extra_notes: |
   suction cup replaced on 2025-10-02
   keep: the text exactly
 real_pos: [[1, 2]]   # malformed, but not ours to touch
+park_pos: *home
 """
 
 

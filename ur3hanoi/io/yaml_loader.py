@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 import yaml
-from yaml.constructor import ConstructorError
+from yaml.constructor import ConstructorError, SafeConstructor
 from yaml.nodes import MappingNode, Node, ScalarNode
 
 from ur3hanoi.errors import InputError, printable, quote
@@ -49,12 +49,72 @@ def _octal(text: str) -> bool:
     return len(digits) > 1 and digits[0] == "0" and digits.isdigit()
 
 
+def _plain(node: ScalarNode) -> bool:
+    """An unquoted scalar: PyYAML's Python parser gives it the style None, its libyaml parser ``""``."""
+    return not node.style
+
+
 class YamlLimitError(yaml.MarkedYAMLError):
     """A document exceeds one of the limits of :mod:`ur3hanoi.io.limits`."""
 
 
-class StrictLoader(yaml.SafeLoader):
-    """``yaml.SafeLoader`` that refuses duplicate keys, alias bombs, deep nesting and huge integers."""
+class StrictConstructor(SafeConstructor):
+    """``SafeConstructor`` that refuses duplicate keys and huge integers and keeps YAML 1.1 surprises as
+    :class:`Yaml11Reading` (the construction half of :class:`StrictLoader`, shared with the libyaml read-back of
+    :func:`reparse_yaml`)."""
+
+    def construct_mapping(self, node: MappingNode, deep: bool = False) -> dict[Any, Any]:
+        if isinstance(node, MappingNode):
+            first: dict[Any, Any] = {}
+            for key_node, _ in node.value:
+                if key_node.tag == _MERGE_TAG:
+                    continue
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    seen = first.get(key)
+                except TypeError:  # unhashable: the base class reports it
+                    continue
+                if seen is not None:
+                    raise ConstructorError(None, None, f"duplicate key {quote(key)} (first given on line "
+                                                       f"{seen.line + 1})", key_node.start_mark)
+                first[key] = key_node.start_mark
+        return super().construct_mapping(node, deep=deep)
+
+    def construct_yaml_int(self, node: ScalarNode) -> int | Yaml11Reading:  # type: ignore[override]
+        text = str(node.value)
+        if sum(c.isalnum() for c in text) > MAX_INT_DIGITS:
+            raise YamlLimitError(problem=f"integer longer than {MAX_INT_DIGITS} digits", problem_mark=node.start_mark)
+        value: int = super().construct_yaml_int(node)
+        if _plain(node) and _octal(text) and int(text.replace("_", ""), 10) != value:
+            return Yaml11Reading(text, value, f"the octal number {value}", node.start_mark.line + 1)
+        if _plain(node) and ":" in text:
+            return Yaml11Reading(text, value, f"{value} (a base-60 number)", node.start_mark.line + 1)
+        return value
+
+    def construct_yaml_float(self, node: ScalarNode) -> float | Yaml11Reading:  # type: ignore[override]
+        value: float = super().construct_yaml_float(node)
+        if _plain(node) and ":" in str(node.value):
+            return Yaml11Reading(str(node.value), value, f"{value:g} (a base-60 number)", node.start_mark.line + 1)
+        return value
+
+    def construct_yaml_bool(self, node: ScalarNode) -> bool | Yaml11Reading:  # type: ignore[override]
+        value: bool = super().construct_yaml_bool(node)
+        if _plain(node) and str(node.value).lower() in _YAML11_BOOLS:
+            return Yaml11Reading(str(node.value), value, f"the boolean {str(value).lower()}", node.start_mark.line + 1)
+        return value
+
+
+def _use_strict_scalars(loader: Any) -> None:
+    """Register :class:`StrictConstructor`'s integer, float and boolean constructors on ``loader`` (a loader class
+    looks its constructors up in its own table)."""
+    loader.add_constructor("tag:yaml.org,2002:int", StrictConstructor.construct_yaml_int)
+    loader.add_constructor("tag:yaml.org,2002:float", StrictConstructor.construct_yaml_float)
+    loader.add_constructor("tag:yaml.org,2002:bool", StrictConstructor.construct_yaml_bool)
+
+
+class StrictLoader(StrictConstructor, yaml.SafeLoader):
+    """``yaml.SafeLoader`` that refuses duplicate keys, alias bombs, deep nesting and huge integers (composed in
+    Python, so that every node is counted before the next is read)."""
 
     def __init__(self, stream: str) -> None:
         super().__init__(stream)
@@ -93,50 +153,8 @@ class StrictLoader(yaml.SafeLoader):
             self._anchored_sizes[id(node)] = self._nodes - before
         return node
 
-    def construct_mapping(self, node: MappingNode, deep: bool = False) -> dict[Any, Any]:
-        if isinstance(node, MappingNode):
-            first: dict[Any, Any] = {}
-            for key_node, _ in node.value:
-                if key_node.tag == _MERGE_TAG:
-                    continue
-                key = self.construct_object(key_node, deep=True)
-                try:
-                    seen = first.get(key)
-                except TypeError:  # unhashable: the base class reports it
-                    continue
-                if seen is not None:
-                    raise ConstructorError(None, None, f"duplicate key {quote(key)} (first given on line "
-                                                       f"{seen.line + 1})", key_node.start_mark)
-                first[key] = key_node.start_mark
-        return super().construct_mapping(node, deep=deep)
 
-    def construct_yaml_int(self, node: ScalarNode) -> int | Yaml11Reading:  # type: ignore[override]
-        text = str(node.value)
-        if sum(c.isalnum() for c in text) > MAX_INT_DIGITS:
-            raise YamlLimitError(problem=f"integer longer than {MAX_INT_DIGITS} digits", problem_mark=node.start_mark)
-        value: int = super().construct_yaml_int(node)
-        if node.style is None and _octal(text) and int(text.replace("_", ""), 10) != value:
-            return Yaml11Reading(text, value, f"the octal number {value}", node.start_mark.line + 1)
-        if node.style is None and ":" in text:
-            return Yaml11Reading(text, value, f"{value} (a base-60 number)", node.start_mark.line + 1)
-        return value
-
-    def construct_yaml_float(self, node: ScalarNode) -> float | Yaml11Reading:  # type: ignore[override]
-        value: float = super().construct_yaml_float(node)
-        if node.style is None and ":" in str(node.value):
-            return Yaml11Reading(str(node.value), value, f"{value:g} (a base-60 number)", node.start_mark.line + 1)
-        return value
-
-    def construct_yaml_bool(self, node: ScalarNode) -> bool | Yaml11Reading:  # type: ignore[override]
-        value: bool = super().construct_yaml_bool(node)
-        if node.style is None and str(node.value).lower() in _YAML11_BOOLS:
-            return Yaml11Reading(str(node.value), value, f"the boolean {str(value).lower()}", node.start_mark.line + 1)
-        return value
-
-
-StrictLoader.add_constructor("tag:yaml.org,2002:int", StrictLoader.construct_yaml_int)
-StrictLoader.add_constructor("tag:yaml.org,2002:float", StrictLoader.construct_yaml_float)
-StrictLoader.add_constructor("tag:yaml.org,2002:bool", StrictLoader.construct_yaml_bool)
+_use_strict_scalars(StrictLoader)
 
 
 BOM = "\ufeff"
@@ -177,6 +195,86 @@ def parse_yaml(text: str, source: str, *, what: str = "YAML file", error: type[I
         raise error.file(source, f"not valid YAML: {_describe(exc)}") from None
     except (ValueError, OverflowError, RecursionError) as exc:  # e.g. a timestamp with month 13
         raise error.file(source, f"not valid YAML: {printable(exc, 120)}") from None
+
+
+if yaml.__with_libyaml__:
+    from yaml._yaml import CParser
+
+    class _LibyamlReparse(CParser, StrictConstructor, yaml.resolver.Resolver):
+        """libyaml's parser and composer with :class:`StrictConstructor` (PyYAML's ``CSafeLoader`` with the strict
+        construction): it composes in C, so the limits are checked on the composed graph (:func:`_check_graph`)."""
+
+        def __init__(self, stream: str) -> None:
+            CParser.__init__(self, stream)
+            StrictConstructor.__init__(self)
+            yaml.resolver.Resolver.__init__(self)
+
+    _use_strict_scalars(_LibyamlReparse)
+
+
+def _children(node: Node) -> list[Node]:
+    if isinstance(node, MappingNode):
+        return [n for pair in node.value for n in pair]
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    return []
+
+
+def _check_graph(root: Node) -> None:
+    """The limits :class:`StrictLoader` checks while composing, checked on a composed graph (depth-first, in
+    document order): at most ``MAX_DEPTH`` levels, ``MAX_ALIASES`` aliases (a node met again after its anchor) and
+    ``MAX_NODES`` nodes with every alias counted as the nodes it expands to; an alias inside its own anchor (a
+    cycle) is refused."""
+    sizes: dict[int, int] = {}  # id -> expanded size, of every finished node
+    on_path = {id(root)}
+    aliases = 0
+    stack = [(root, 1, iter(_children(root)))]
+    while stack:
+        node, depth, rest = stack[-1]
+        child = next(rest, None)
+        if child is None:
+            stack.pop()
+            on_path.discard(id(node))
+            sizes[id(node)] = 1 + sum(sizes[id(c)] for c in _children(node))
+            if sizes[id(node)] > MAX_NODES:
+                raise YamlLimitError(problem=f"more than {MAX_NODES} nodes (aliases counted expanded)",
+                                     problem_mark=node.start_mark)
+        elif id(child) in on_path:
+            raise YamlLimitError(problem="an alias is used inside its own anchor (a recursive document)",
+                                 problem_mark=child.start_mark)
+        elif id(child) in sizes:
+            aliases += 1
+            if aliases > MAX_ALIASES:
+                raise YamlLimitError(problem=f"more than {MAX_ALIASES} aliases", problem_mark=child.start_mark)
+        elif depth >= MAX_DEPTH:
+            raise YamlLimitError(problem=f"nested deeper than {MAX_DEPTH} levels", problem_mark=child.start_mark)
+        else:
+            on_path.add(id(child))
+            stack.append((child, depth + 1, iter(_children(child))))
+
+
+def reparse_yaml(text: str, source: str, *, what: str = "YAML file", error: type[InputError] = InputError) -> Any:
+    """:func:`parse_yaml` of ``text``, read by libyaml's C parser when PyYAML has it (an order of magnitude faster):
+    the same data, or :func:`parse_yaml`'s error.
+
+    For a text made from a document :func:`parse_yaml` accepted (the read-back of a key spliced into a lab file):
+    libyaml composes recursively in C, so its nesting must already be known to be bounded. The limits, duplicate
+    keys and YAML 1.1 readings are checked as :func:`parse_yaml` checks them; on anything libyaml or these checks
+    refuse, :func:`parse_yaml` reads the text and words the error.
+    """
+    if not yaml.__with_libyaml__:
+        return parse_yaml(text, source, what=what, error=error)
+    loader = _LibyamlReparse(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _check_graph(node)
+        return loader.construct_document(node)
+    except (yaml.YAMLError, ValueError, OverflowError, RecursionError):
+        return parse_yaml(text, source, what=what, error=error)
+    finally:
+        loader.dispose()
 
 
 def decode_utf8(raw: bytes, source: str, *, what: str = "YAML file", error: type[InputError] = InputError) -> str:

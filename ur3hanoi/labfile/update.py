@@ -102,10 +102,10 @@ def _check_read_back(text: str, old: LabFile, sections: Sections, shown: str) ->
     if text == old.text:
         new_data: Any = old.data
     else:
-        from ur3hanoi.io.yaml_loader import parse_yaml
+        from ur3hanoi.io.yaml_loader import reparse_yaml
 
-        try:
-            new_data = parse_yaml(text, shown, what=WHAT, error=TableError)
+        try:  # the old text passed the strict loader: its nesting is bounded, libyaml may read it back
+            new_data = reparse_yaml(text, shown, what=WHAT, error=TableError)
         except TableError as exc:
             raise refuse(str(exc).removeprefix(f"{printable(shown)}: ")) from None
     if not isinstance(new_data, dict):
