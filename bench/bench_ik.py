@@ -6,6 +6,7 @@ Run: .venv/bin/python bench/bench_ik.py   (targets: 18-pose table < 5 ms of IK c
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -43,16 +44,19 @@ def bench_solver(name: str, station_path: Path, repeats: int = 200) -> dict[str,
     return {"us_per_pose": med / len(targets) * 1e6, "ms_per_table": med * 1e3, "poses": len(targets)}
 
 
-def bench_cli(repeats: int = 5) -> float:
+def bench_cli(repeats: int = 5) -> tuple[float, float]:
+    """Wall time [s] of ``ur3hanoi tables`` with an empty user cache (the first run: NumPy and the IK) and the median
+    of the next ``repeats`` runs (the generated key from the cache)."""
     walls = []
     with tempfile.TemporaryDirectory() as tmp:
-        for _ in range(repeats):
+        env = {**os.environ, "XDG_CACHE_HOME": f"{tmp}/xdg"}  # never the user's own cache
+        for _ in range(repeats + 1):
             t0 = time.perf_counter()
             subprocess.run([sys.executable, "-m", "ur3hanoi.cli", "tables", "lab_sim",
                             "--key", "sim_pos", "-o", f"{tmp}/lab2_data.yaml"], cwd=REPO, check=True,
-                           capture_output=True)
+                           capture_output=True, env=env)
             walls.append(time.perf_counter() - t0)
-    return float(np.median(walls))
+    return walls[0], float(np.median(walls[1:]))
 
 
 def main() -> dict[str, object]:
@@ -63,9 +67,10 @@ def main() -> dict[str, object]:
             results[f"ik_{name}_{station}"] = r
             print(f"IK {name:9s} {station:8s}: {r['us_per_pose']:7.1f} us/pose, {r['ms_per_table']:.2f} ms per "
                   f"{r['poses']}-pose table (target < 5 ms)")
-    wall = bench_cli()
-    results["tables_cli_wall_s"] = wall
-    print(f"`ur3hanoi tables` end to end (lab_sim): {wall:.3f} s wall (target < 1 s)")
+    first, cached = bench_cli()
+    results["tables_cli_wall_s"] = {"first": first, "cached": cached}
+    print(f"`ur3hanoi tables` end to end (lab_sim): {first:.3f} s wall with an empty user cache, {cached:.3f} s "
+          "(median of 5) with its generated key cached (target < 1 s)")
     return results
 
 
