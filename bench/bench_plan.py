@@ -20,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -137,15 +138,20 @@ def lab() -> None:
 def cli() -> None:
     for name in ("lab_sim", "lab_real"):
         walls, codes = [], set()
+        cache = tempfile.mkdtemp(prefix="ur3hanoi-bench-cli-")  # its own user cache: lab() filled the script's
         for _ in range(4):  # the first run of the station (nothing of it cached), then three from the user cache
             t0 = time.perf_counter()
             proc = subprocess.run([str(Path(sys.executable).parent / "ur3hanoi"), "plan", "--start", "1", "--end", "3",
-                                   "--calibration", name], capture_output=True, text=True, cwd=ROOT)
+                                   "--calibration", name], capture_output=True, text=True, cwd=ROOT,
+                                  env={**os.environ, "XDG_CACHE_HOME": cache})
             walls.append(time.perf_counter() - t0)
             codes.add(proc.returncode)
-        print(f"cold `ur3hanoi plan --start 1 --end 3 --calibration {name}`: first run {walls[0]:.3f} s; with its "
-              f"entries in the user cache best {min(walls[1:]):.3f} s, median {statistics.median(walls[1:]):.3f} s "
-              f"(exit {sorted(codes)}; target < 1 s)")
+        shutil.rmtree(cache, ignore_errors=True)
+        cached = statistics.median(walls[1:])
+        print(f"cold `ur3hanoi plan --start 1 --end 3 --calibration {name}`: first run {walls[0]:.3f} s "
+              f"({'within' if walls[0] < 1 else 'over'} the 1 s target); with its entries in the user cache best "
+              f"{min(walls[1:]):.3f} s, median {cached:.3f} s ({'within' if cached < 1 else 'over'} it; "
+              f"exit {sorted(codes)})")
 
 
 def scaling() -> None:
