@@ -228,14 +228,15 @@ def _check_graph(root: Node) -> None:
     sizes: dict[int, int] = {}  # id -> expanded size, of every finished node
     on_path = {id(root)}
     aliases = 0
-    stack = [(root, 1, iter(_children(root)))]
+    root_children = _children(root)
+    stack = [(root, 1, root_children, iter(root_children))]
     while stack:
-        node, depth, rest = stack[-1]
+        node, depth, children, rest = stack[-1]
         child = next(rest, None)
         if child is None:
             stack.pop()
             on_path.discard(id(node))
-            sizes[id(node)] = 1 + sum(sizes[id(c)] for c in _children(node))
+            sizes[id(node)] = 1 + sum(sizes[id(c)] for c in children)
             if sizes[id(node)] > MAX_NODES:
                 raise YamlLimitError(problem=f"more than {MAX_NODES} nodes (aliases counted expanded)",
                                      problem_mark=node.start_mark)
@@ -250,7 +251,8 @@ def _check_graph(root: Node) -> None:
             raise YamlLimitError(problem=f"nested deeper than {MAX_DEPTH} levels", problem_mark=child.start_mark)
         else:
             on_path.add(id(child))
-            stack.append((child, depth + 1, iter(_children(child))))
+            grandchildren = _children(child)
+            stack.append((child, depth + 1, grandchildren, iter(grandchildren)))
 
 
 def reparse_yaml(text: str, source: str, *, what: str = "YAML file", error: type[InputError] = InputError) -> Any:
@@ -301,6 +303,12 @@ def load_yaml_file(path: str | Path, *, what: str, error: type[InputError] = Inp
     """
     source = str(path) if source is None else source
     raw = read_input_bytes(path, what=what, error=error, source=source, missing_hint=missing_hint)
+    return parse_yaml_bytes(raw, source, what=what, error=error)
+
+
+def parse_yaml_bytes(raw: bytes, source: str, *, what: str = "YAML file",
+                     error: type[InputError] = InputError) -> YamlFile:
+    """A YAML file from the bytes ``raw`` read from it (:func:`decode_utf8`, then :func:`parse_yaml`)."""
     text = decode_utf8(raw, source, what=what, error=error)
     data = parse_yaml(text, source, what=what, error=error)
     return YamlFile(data=data, text=text, sha256=hashlib.sha256(raw).hexdigest(), bom=raw.startswith(codecs.BOM_UTF8))

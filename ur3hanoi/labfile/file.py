@@ -7,8 +7,6 @@ Checking a key's value is :mod:`~ur3hanoi.labfile.read`'s.
 
 from __future__ import annotations
 
-import codecs
-import hashlib
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -54,17 +52,16 @@ def parse_lab_file(raw: bytes, source: str) -> LabFile:
     Raises:
         TableError: not UTF-8, not strict YAML, or its top level is not a mapping; the message names ``source``.
     """
-    from ur3hanoi.io.yaml_loader import decode_utf8, parse_yaml
+    from ur3hanoi.io.yaml_loader import parse_yaml_bytes
 
-    text = decode_utf8(raw, source, what=WHAT, error=TableError)
-    data = parse_yaml(text, source, what=WHAT, error=TableError)
-    data = {} if data is None else data
+    doc = parse_yaml_bytes(raw, source, what=WHAT, error=TableError)
+    data = {} if doc.data is None else doc.data
     if not isinstance(data, dict):
         from ur3hanoi.io.schema import describe_type
 
         raise TableError.file(source, f"the top level is {describe_type(data)}, not a mapping of keys "
                                       f"({', '.join(KNOWN_KEYS)}, or your own): not a {WHAT}")
-    return LabFile(data=data, text=text, sha256=hashlib.sha256(raw).hexdigest(), bom=raw.startswith(codecs.BOM_UTF8))
+    return LabFile(data=data, text=doc.text, sha256=doc.sha256, bom=doc.bom)
 
 
 def check_key(key: str) -> None:

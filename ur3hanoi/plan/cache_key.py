@@ -9,26 +9,21 @@ changed planner is a new entry, never a stale result.
 
 from __future__ import annotations
 
-import hashlib
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
+from ur3hanoi import cache
 from ur3hanoi.robot import load_ur3
 from ur3hanoi.station import Station
 
-_PACKAGE = Path(__file__).resolve().parents[1]  # ur3hanoi/
+PLANNER_SOURCE: tuple[str, ...] = ("plan", "")
+"""The planner's source, by :func:`ur3hanoi.cache.source_digest`: the ``plan`` package and the top-level modules."""
 
 
-@lru_cache(maxsize=1)
 def source_digest() -> bytes:
     """sha256 of the planner's source: every module of the ``ur3hanoi.plan`` package and the top-level modules."""
-    h = hashlib.sha256()
-    for path in [*sorted((_PACKAGE / "plan").rglob("*.py")), *sorted(_PACKAGE.glob("*.py"))]:
-        h.update(path.relative_to(_PACKAGE).as_posix().encode() + b"\0")
-        h.update(hashlib.sha256(path.read_bytes()).digest())
-    return h.digest()
+    return cache.source_digest(PLANNER_SOURCE)
 
 
 @lru_cache(maxsize=16)
