@@ -1,7 +1,7 @@
 """Benchmark (not a test): how often `check-table --fit` cries wolf on recorded-like tables, how often it names an
 injected gross error first, and its wall time.
 
-Recorded-like tables (tests/recorded_tables.py, `recorded_like`): 1-2 mm jitter, a heading per tower and wrist 3
+Recorded-like tables (tests/support/recorded_tables.py, `recorded_like`): 1-2 mm jitter, a heading per tower and wrist 3
 turned per entry, a small table-wide tilt of the suction axis, above poses 15-60 mm over the top of the stacks;
 stacked stations (lab_real robot, three towers 5-15 cm apart, uneven) and the flat Gazebo layout (lab_sim).
 
@@ -31,9 +31,9 @@ sys.path.insert(0, str(REPO))
 
 from tests import recorded_tables as rt  # noqa: E402
 from ur3hanoi.audit import audit_table  # noqa: E402
-from ur3hanoi.grid import ON  # noqa: E402
-from ur3hanoi.labfile import read_recorded_table  # noqa: E402
-from ur3hanoi.station import load_station  # noqa: E402
+from ur3hanoi.station.calibration import load_station  # noqa: E402
+from ur3hanoi.station.grid import ON  # noqa: E402
+from ur3hanoi.tables import read_recorded_table  # noqa: E402
 
 ERRORS = ("typo-j1-10deg", "typo-j2-3deg", "swapped-heights", "duplicated", "tilt-5-6deg")
 

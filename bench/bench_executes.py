@@ -22,7 +22,7 @@ def main() -> int:
     from ur3hanoi.plan.checks.suction import check_suction_hold
     from ur3hanoi.sim import run_plan
     from ur3hanoi.sim.scene import slot_centers
-    from ur3hanoi.station import load_station
+    from ur3hanoi.station.calibration import load_station
 
     real = load_station("lab_real")
     tall = dataclasses.replace(real, name="tall8", n_heights=8,

@@ -15,11 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ur3hanoi.grid import T_base_tcp
-from ur3hanoi.ik import SOLVERS, branch_of, make_solver, solve_on_branch
-from ur3hanoi.resources import stations_dir
-from ur3hanoi.robot import load_ur3
-from ur3hanoi.station import load_station
+from ur3hanoi.io.resources import stations_dir
+from ur3hanoi.robot.ik import SOLVERS, branch_of, make_solver, solve_on_branch
+from ur3hanoi.robot.model import load_ur3
+from ur3hanoi.station.calibration import load_station
+from ur3hanoi.station.grid import T_base_tcp
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -3,8 +3,8 @@
 Run: ``.venv/bin/python bench/bench_plan.py``. Reports, in one run:
 
 1. 3 blocks, tower 1 -> 3, on lab_sim and lab_real, motion and whole-cycle time of: the lab program itself (the
-   baseline: ``tests/lab2_exec_starter.py``, movej per waypoint at v = a = 4 with its polling and sleeps), the plan,
-   the jerk-limited stop-and-go and a v+a lower bound; ratios to the lab program (targets: motion <= 0.80, cycle
+   baseline: ``tests/support/lab2_exec_starter.py``, movej per waypoint at v = a = 4 with its polling and sleeps), the
+   plan, the jerk-limited stop-and-go and a v+a lower bound; ratios to the lab program (targets: motion <= 0.80, cycle
    <= 0.70, goal 0.65), and the worst distance from the vertical line by forward kinematics at 1 kHz.
 2. Cold ``ur3hanoi plan --start 1 --end 3`` (process start to exit, clearance checks included; target < 1 s): the
    station's first run, then runs with its entries in the user cache (a private one, empty when the script starts).
@@ -34,7 +34,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _tall():  # type: ignore[no-untyped-def]
-    from ur3hanoi.station import load_station
+    from ur3hanoi.station.calibration import load_station
 
     real = load_station("lab_real")
     return dataclasses.replace(real, n_heights=10, tower_origins=tuple((0.22, y, z) for _, y, z in real.tower_origins))
@@ -45,8 +45,8 @@ def one(n: int) -> None:
     t0 = time.perf_counter()
     from ur3hanoi.plan import plan_solve
     from ur3hanoi.plan.checks.clearance import clearance_cache
+    from ur3hanoi.plan.motion.waypoints import build_waypoints, geometry_key
     from ur3hanoi.plan.types import PlanConfig
-    from ur3hanoi.plan.waypoints import build_waypoints, geometry_key
 
     t_import = time.perf_counter() - t0
     tall = _tall()
@@ -106,12 +106,12 @@ def bound_motion_s(plan) -> float:  # type: ignore[no-untyped-def]
 
 def lab() -> None:
     from ur3hanoi.plan import PlanConfig, plan_solve
-    from ur3hanoi.station import load_station
+    from ur3hanoi.station.calibration import load_station
 
     print("3 blocks, tower 1 -> 3. motion = time moving; cycle = the whole program (dwells/sleeps, polling included).")
-    print("lab program = tests/lab2_exec_starter.py: movej per waypoint at v = a = 4 (UR synchronised trapezoid,")
-    print("capped at the datasheet speeds and 4/8 rad/s^2), its 20 Hz polling and its 1.0 s + 0.5 s sleeps per move.")
-    print("stop-and-go = jerk-limited Ruckig rest to rest between the same waypoints, the plan's dwells.")
+    print("lab program = tests/support/lab2_exec_starter.py: movej per waypoint at v = a = 4 (UR synchronised")
+    print("trapezoid, capped at the datasheet speeds and 4/8 rad/s^2), its 20 Hz polling and its 1.0 s + 0.5 s sleeps")
+    print("per move. stop-and-go = jerk-limited Ruckig rest to rest between the same waypoints, the plan's dwells.")
     print("bound = v+a lower bound of the plan's segments (jerk x1e4), the plan's dwells.")
     print(f"{'station':<9} {'':>6} {'lab prog':>9} {'plan':>8} {'ratio':>6} {'stop&go':>8} {'ratio':>6} "
           f"{'bound':>8} {'ratio':>6}")

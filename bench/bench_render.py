@@ -57,7 +57,7 @@ def bench_frame(n: int) -> None:
 
     from ur3hanoi.sim import build_task_scene
     from ur3hanoi.sim.render import CameraConfig, _draw, _free_camera, _set_quality
-    from ur3hanoi.station import load_station
+    from ur3hanoi.station.calibration import load_station
 
     def cpu_self() -> float:
         r = resource.getrusage(resource.RUSAGE_SELF)

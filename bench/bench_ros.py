@@ -4,7 +4,8 @@
 Usage: .venv/bin/python bench/bench_ros.py [--v V] [--a A]
 Measures, each against a fresh station (own roscore on a free port, tower 1 -> 3):
 - `ur3hanoi ros-solve` wall time (the client's own figure: first command to home),
-- the lab-style client tests/lab2_exec_starter.py (written like the course's lab2_exec.py: 20 Hz polling, 1 s sleep
+- the lab-style client tests/support/lab2_exec_starter.py (written like the course's lab2_exec.py: 20 Hz polling, 1 s
+  sleep
   after every grasp) wall time, run with `ur3hanoi ros-env`'s environment,
 - the station's control loop: worst and mean lag of a cycle's start behind its wall-clock schedule, cycles more than
   one period late, publishing rate; and how the arm settled (worst time from a profile's end to within 0.0005 rad,
@@ -35,7 +36,7 @@ from typing import Any
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from ur3hanoi.ros.master import RosCore  # noqa: E402
+from ur3hanoi.interface.ros1.master import RosCore  # noqa: E402
 
 TIMEOUT_S = 300.0
 
@@ -92,7 +93,7 @@ def rss_kb(pid: int) -> int:
 
 def flood_once(tmp: Path, seconds: float) -> dict[str, Any]:
     """One station, one 1 kHz flood of ``seconds``; the figures of the module docstring."""
-    from ur3hanoi.station import load_station
+    from ur3hanoi.station.calibration import load_station
 
     port = free_port()
     env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{port}", ROS_HOME=str(tmp / "ros_home"),

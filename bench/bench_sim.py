@@ -19,10 +19,10 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from ur3hanoi.io.resources import stations_dir  # noqa: E402
 from ur3hanoi.plan import plan_solve  # noqa: E402
-from ur3hanoi.resources import stations_dir  # noqa: E402
 from ur3hanoi.sim import run_plan  # noqa: E402
-from ur3hanoi.station import load_station  # noqa: E402
+from ur3hanoi.station.calibration import load_station  # noqa: E402
 
 
 def main() -> int:

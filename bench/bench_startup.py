@@ -134,8 +134,7 @@ def per_call_us(fn: Callable[[], object], repeats: int) -> float:
 
 
 def bench_ik_station(name: str, repeats: int) -> list[str]:
-    from ur3hanoi.grid import T_base_tcp
-    from ur3hanoi.ik import (
+    from ur3hanoi.robot.ik import (
         SOLVERS,
         IKSolver,
         analytic_ik,
@@ -145,9 +144,10 @@ def bench_ik_station(name: str, repeats: int) -> list[str]:
         solve_on_branch,
         solve_table_on_branch,
     )
-    from ur3hanoi.robot import load_ur3
-    from ur3hanoi.station import load_station
-    from ur3hanoi.waypoints import generate_table
+    from ur3hanoi.robot.model import load_ur3
+    from ur3hanoi.station.calibration import load_station
+    from ur3hanoi.station.grid import T_base_tcp
+    from ur3hanoi.tables.ik_table import generate_table
 
     station = load_station(name)
     robot = load_ur3(station.tool, station.limits)

@@ -5,7 +5,7 @@ the jerk limit scaled by 1..100 (acceleration caps fixed at 4/8 rad/s^2, datashe
 MuJoCo and records, at every control cycle of a carrying phase, the weld's stretch (how far the held block's centre
 is from where the suction holds it: :meth:`ur3hanoi.sim.SuctionCup.stretch`) and the suction point's acceleration
 (world frame, from the plan's samples). The seal counts as broken beyond ``SuctionConfig.hold_tolerance`` (10 mm);
-the jerk limit's default (:data:`ur3hanoi.robot.DEFAULT_JERK_MAX`) is the largest of these scales whose worst
+the jerk limit's default (:data:`ur3hanoi.robot.model.DEFAULT_JERK_MAX`) is the largest of these scales whose worst
 stretch stays within a quarter of it (margin 4) and whose plan still passes its own checks.
 """
 
@@ -26,7 +26,7 @@ def measure(name: str, scale: float) -> tuple[float, float, float, str, float]:
     from ur3hanoi.plan.kinematics import tcp_positions_world
     from ur3hanoi.sim import executor
     from ur3hanoi.sim.suction import SuctionCup
-    from ur3hanoi.station import load_station
+    from ur3hanoi.station.calibration import load_station
 
     st = load_station(name)
     plan = plan_solve(st, 0, 2, 3, PlanConfig(j_max=tuple(j * scale for j in BASE)))

@@ -10,16 +10,17 @@ from pathlib import Path
 
 import pytest
 
-from ur3hanoi.resources import stations_dir
-from ur3hanoi.station import Station, load_station
+from ur3hanoi.io.resources import stations_dir
+from ur3hanoi.station.calibration import Station, load_station
 
 # Headless offscreen rendering. MuJoCo reads it when first imported, i.e. while the first test module importing
 # ur3hanoi.sim is collected: it must be set before any of them.
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-# The suite has a user cache of its own (ur3hanoi.cache: collision geometry, plan connections), so that an entry left
+# The suite has a user cache of its own (ur3hanoi.io.cache: collision geometry, plan connections), so that an entry left
 # in the user's cache by another version can never change a result, and the tests leave nothing behind there. The
-# throwaway rclpy environments (tests/rclpy_support.py) stay in the user's real cache: they take minutes to build.
+# throwaway rclpy environments (tests/support/rclpy_support.py) stay in the user's real cache: they take minutes to
+# build.
 os.environ.setdefault("UR3HANOI_RCLPY_CACHE", os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache"))
 _SUITE_CACHE = tempfile.mkdtemp(prefix="ur3hanoi-test-cache-")
 os.environ["XDG_CACHE_HOME"] = _SUITE_CACHE

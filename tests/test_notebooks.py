@@ -14,7 +14,7 @@ from typing import Any
 import nbformat
 import pytest
 
-from .conftest import REPO
+from tests.conftest import REPO
 
 NOTEBOOKS = sorted((REPO / "notebooks").glob("*.ipynb"))
 

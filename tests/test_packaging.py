@@ -20,9 +20,8 @@ import numpy as np
 import pytest
 import yaml
 
-from ur3hanoi.resources import robot_dir, station_names, stations_dir
-
-from .conftest import REPO
+from tests.conftest import REPO
+from ur3hanoi.io.resources import robot_dir, station_names, stations_dir
 
 pytestmark = pytest.mark.packaging
 
@@ -57,10 +56,10 @@ def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_wheel_carries_the_robot_folder_and_the_stations(wheel: Path) -> None:
     names = set(zipfile.ZipFile(wheel).namelist())
-    robot = f"ur3hanoi/robots/{robot_dir().name}"
+    robot = f"ur3hanoi/robot/models/{robot_dir().name}"
     expected = {f"{robot}/{f}" for f in ("ur3.xml", "scene.xml", "LICENSE", "README.md", "CHANGELOG.md")}
     expected |= {f"{robot}/assets/{p.name}" for p in (robot_dir() / "assets").glob("*.stl")}
-    expected |= {f"ur3hanoi/stations/{n}.yaml" for n in station_names()}
+    expected |= {f"ur3hanoi/station/shipped/{n}.yaml" for n in station_names()}
     expected |= {"ur3hanoi/py.typed"}
     assert len(expected) > 10
     assert expected <= names, f"missing from the wheel: {sorted(expected - names)}"
@@ -91,6 +90,6 @@ def test_installed_wheel_runs_the_main_job_from_an_empty_folder(wheel: Path, tmp
     assert "lab2_data.yaml" in left and left <= {"lab2_data.yaml", ".lab2_data.yaml.lock", "lab2_data.yaml.lock"}
 
     # The installed package finds its data inside site-packages, not in this checkout.
-    where = _run([py, "-c", "from ur3hanoi.resources import stations_dir; print(stations_dir())"], cwd=work,
+    where = _run([py, "-c", "from ur3hanoi.io.resources import stations_dir; print(stations_dir())"], cwd=work,
                  timeout=60, env=env).stdout.strip()
     assert Path(where).is_relative_to(env_dir) and not Path(where).is_relative_to(stations_dir().parent)

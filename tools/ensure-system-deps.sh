@@ -3,8 +3,8 @@
 # are root; otherwise says what to install. Python packages from PyPI are not installed here (requirements.lock).
 #  - Headless MuJoCo rendering (MUJOCO_GL=egl: --video/--frames and the notebooks): Mesa's EGL and GL drivers.
 #  - ROS 1 for `ur3hanoi ros-station` / `ros-solve` and their tests: Debian's roscore and pure-Python rospy,
-#    genpy and std_msgs (about 40 s). ur3hanoi.ros appends /usr/lib/python3/dist-packages to the venv's path.
-#  - Debian's chromium: the replay page's test opens it headless with the network off (tests/test_replay.py).
+#    genpy and std_msgs (about 40 s). ur3hanoi.interface.ros1 appends /usr/lib/python3/dist-packages to the venv's path.
+#  - Debian's chromium: the replay page's test opens it headless with the network off (tests/replay/test_page.py).
 set -euo pipefail
 missing=()
 ldconfig -p | grep -q 'libEGL.so.1 ' || missing+=(libegl1)

@@ -1,4 +1,4 @@
-"""Rewrite the README's CLI reference from the parser (`make docs`); tests/test_cli.py fails when it is stale."""
+"""Rewrite the README's CLI reference from the parser (`make docs`); tests/cli/test_main.py fails when it is stale."""
 
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ Two references:
   tool orientation against the station's intended pose, over fixed tolerances (by default :data:`STRICT_MM` /
   :data:`STRICT_DEG`, 1 mm / 0.5 deg): a generated table reproduces its grid to 1e-9 m.
 - **the table itself** (:func:`audit_table`, :mod:`~ur3hanoi.audit.fitted`): the grid fitted robustly to the
-  table's contacts, every entry judged by the rule of :mod:`ur3hanoi.calibrate.rule` (in mm and deg: within 5 mm
+  table's contacts, every entry judged by the rule of :mod:`ur3hanoi.audit.rule` (in mm and deg: within 5 mm
   / 4 deg never flagged, over 8 mm / 5 deg always; the heading about the suction axis never judged; above poses
   clear of the top level and on their contact's line).
 

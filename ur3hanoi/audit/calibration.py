@@ -19,13 +19,13 @@ from ur3hanoi.calibrate import CalibrationFit
 from ur3hanoi.calibrate.explain import diagnose
 from ur3hanoi.calibrate.grid_fit import measure, rotation_error_deg
 from ur3hanoi.calibrate.robust import Thresholds
+from ur3hanoi.calibrate.taught import TaughtPoints
 from ur3hanoi.errors import TableError, printable
-from ur3hanoi.grid import ABOVE, ON, T_world_tcp
-from ur3hanoi.labfile import RecordedTable, Slot
-from ur3hanoi.robot import load_ur3
-from ur3hanoi.station import Station
-from ur3hanoi.taught import TaughtPoints
-from ur3hanoi.waypoints import pose_label
+from ur3hanoi.robot.model import load_ur3
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import ABOVE, ON, T_world_tcp
+from ur3hanoi.tables import RecordedTable, Slot
+from ur3hanoi.tables.ik_table import pose_label
 
 
 def report_from_fit(fit: CalibrationFit, reference: str, shape: tuple[int, int] | None = None, key: str = "Q",

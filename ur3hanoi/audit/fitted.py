@@ -1,4 +1,4 @@
-"""Audit a hand-recorded table on its own (``check-table --fit``), by the rule of :mod:`ur3hanoi.calibrate.rule`.
+"""Audit a hand-recorded table on its own (``check-table --fit``), by the rule of :mod:`ur3hanoi.audit.rule`.
 
 1. Every entry present is measured by FK with the robot base and tool of a base calibration.
 2. The grid (one origin per tower, one step between levels, free in all three axes) is fitted to the **contacts**
@@ -8,7 +8,7 @@
    are judged against the grid, not fitted.
 3. The layout is read off the fitted step: levels stepping sideways are the flat Gazebo layout, stepping up a
    stacked station, whatever ``--base`` says (the note names ``--base lab_sim`` when the two differ).
-4. The table's own suction axis is the robust mean of its contacts' axes (:func:`~ur3hanoi.calibrate.rule.
+4. The table's own suction axis is the robust mean of its contacts' axes (:func:`~ur3hanoi.audit.rule.
    table_axis`); each contact's tilt is its angle from it. The heading about the axis is never judged.
 5. Each contact and above pose is judged by the rule; flagged contacts are explained (a copied entry, swapped
    entries, a pose recorded in another slot, or a typo in one joint when that one change explains most of a large
@@ -27,10 +27,7 @@ from dataclasses import replace
 import numpy as np
 
 from ur3hanoi.audit.report import AuditEntry, AuditReport, AuditSuspect
-from ur3hanoi.calibrate.explain import diagnose_contacts
-from ur3hanoi.calibrate.grid_fit import GridModel, Measured, measure
-from ur3hanoi.calibrate.robust import RobustFit, Thresholds, robust_fit
-from ur3hanoi.calibrate.rule import (
+from ur3hanoi.audit.rule import (
     ABOVE_CLEAR_MM,
     CONTACT_FLAG_MM,
     CONTACT_OK_MM,
@@ -44,13 +41,16 @@ from ur3hanoi.calibrate.rule import (
     judge_contact,
     table_axis,
 )
+from ur3hanoi.calibrate.explain import diagnose_contacts
+from ur3hanoi.calibrate.grid_fit import GridModel, Measured, measure
+from ur3hanoi.calibrate.robust import RobustFit, Thresholds, robust_fit
+from ur3hanoi.calibrate.taught import taught_from_recorded
 from ur3hanoi.errors import TaughtPointsError, printable
-from ur3hanoi.grid import ABOVE, ON
-from ur3hanoi.labfile import RecordedTable, Slot
-from ur3hanoi.robot import load_ur3
-from ur3hanoi.station import Station
-from ur3hanoi.taught import taught_from_recorded
-from ur3hanoi.waypoints import pose_label
+from ur3hanoi.robot.model import load_ur3
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import ABOVE, ON
+from ur3hanoi.tables import RecordedTable, Slot
+from ur3hanoi.tables.ik_table import pose_label
 
 
 def _grid_like(base: Station, n_towers: int, n_heights: int) -> Station:
@@ -82,7 +82,7 @@ def _layout_note(base: Station, layout: str, step: np.ndarray, fitted: bool) -> 
 
 def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None, tol_deg: float | None = None
                 ) -> AuditReport:
-    """Audit ``table`` on its own by the rule of :mod:`ur3hanoi.calibrate.rule` (see the module docstring).
+    """Audit ``table`` on its own by the rule of :mod:`ur3hanoi.audit.rule` (see the module docstring).
 
     Args:
         table: the recorded table.

@@ -14,10 +14,10 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from ur3hanoi.audit.rule import AuditRule
 from ur3hanoi.calibrate.robust import Thresholds
-from ur3hanoi.calibrate.rule import AuditRule
-from ur3hanoi.grid import POSE_NAMES
-from ur3hanoi.waypoints import pose_label
+from ur3hanoi.station.grid import POSE_NAMES
+from ur3hanoi.tables.ik_table import pose_label
 
 STRICT_MM = 1.0
 """[mm] default position tolerance against a calibration (generated tables)."""

@@ -11,7 +11,7 @@ point::
     ur3hanoi calibrate --from-table lab2_data.yaml --key real_pos --base lab_real -o out.yaml
 
 The same robust fit, on a table's contacts alone, audits a table on its own (``ur3hanoi check-table --fit``,
-:mod:`ur3hanoi.audit.fitted`), judging every entry by the rule of :mod:`~ur3hanoi.calibrate.rule`.
+:mod:`ur3hanoi.audit.fitted`), judging every entry by the rule of :mod:`~ur3hanoi.audit.rule`.
 
 Module map:
 
@@ -21,7 +21,7 @@ Module map:
   from the data's robust scatter (``max(3 mm, 5 sigma)``, ``max(2 deg, 5 sigma)``).
 - :mod:`~ur3hanoi.calibrate.explain`: why a pose is off (a typo in one joint, swapped or copied entries, a pose
   recorded in the wrong slot); :func:`~ur3hanoi.calibrate.explain.diagnose_contacts` with the heading left free.
-- :mod:`~ur3hanoi.calibrate.rule`: the audit rule in mm and deg (contacts: never flagged within 5 mm / 4 deg,
+- :mod:`~ur3hanoi.audit.rule`: the audit rule in mm and deg (contacts: never flagged within 5 mm / 4 deg,
   always over 8 mm / 5 deg; above poses clear of the top level and on their contact's line).
 - :mod:`~ur3hanoi.calibrate.fit`: :func:`fit_station`, the :class:`CalibrationFit` result and its suspects.
 - :mod:`~ur3hanoi.calibrate.output`: the calibration file written (refused when the fit is not sound).
@@ -32,7 +32,7 @@ a stacked base, the base's step turned with the fitted tower row for a flat one)
 above poses are used), and the tool yaw (circular mean of the TCP headings). Everything else (robot base, TCP
 offset, block size, contact depth, home, joint limits, counts, layout) is copied from the base calibration.
 
-The taught-points file and its checks are :mod:`ur3hanoi.taught`.
+The taught-points file and its checks are :mod:`ur3hanoi.calibrate.taught`.
 """
 
 from __future__ import annotations

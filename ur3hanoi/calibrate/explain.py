@@ -26,9 +26,9 @@ import numpy as np
 import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.grid import R_world_tcp_down
-from ur3hanoi.labfile import Slot
-from ur3hanoi.robot import Ur3Model
+from ur3hanoi.robot.model import Ur3Model
+from ur3hanoi.station.grid import R_world_tcp_down
+from ur3hanoi.tables import Slot
 
 JOINT_LABELS: tuple[str, ...] = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
 """What the teach pendant calls joints 1..6."""
@@ -203,7 +203,7 @@ def diagnose(robot: Ur3Model, T_world_base: pin.SE3, slots: Sequence[Slot], qs: 
         yaw: the grid's tool yaw [rad]; tol_mm, tol_deg: the thresholds.
         labels: how each point is named (``"tower 1 height 2 on (real_pos[0][1][0])"``).
     """
-    from ur3hanoi.waypoints import pose_label
+    from ur3hanoi.tables.ik_table import pose_label
 
     dup = duplicates(slots, qs, [False] * len(slots))
     swaps = find_swaps(slots, p_world, grid_points, suspects, tol_mm)
@@ -290,7 +290,7 @@ def diagnose_contacts(robot: Ur3Model, T_world_base: pin.SE3, slots: Sequence[Sl
             ones.
         labels: how each contact is named.
     """
-    from ur3hanoi.waypoints import pose_label
+    from ur3hanoi.tables.ik_table import pose_label
 
     dup = duplicates(slots, qs, [False] * len(slots))
     swaps = find_swaps(slots, p_world, grid_points, suspects, flag_mm)

@@ -37,14 +37,14 @@ from ur3hanoi.calibrate.grid_fit import (
     measure,
 )
 from ur3hanoi.calibrate.robust import RobustFit, Thresholds, robust_fit
+from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
 from ur3hanoi.errors import CalibrationError, TaughtPointsError, printable
-from ur3hanoi.grid import ABOVE, ON, POSE_NAMES
-from ur3hanoi.ik import wrap_angle
-from ur3hanoi.labfile import Slot
-from ur3hanoi.robot import load_ur3
-from ur3hanoi.station import Station
-from ur3hanoi.taught import TaughtPoint, TaughtPoints
-from ur3hanoi.waypoints import pose_label
+from ur3hanoi.robot.ik import wrap_angle
+from ur3hanoi.robot.model import load_ur3
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import ABOVE, ON, POSE_NAMES
+from ur3hanoi.tables import Slot
+from ur3hanoi.tables.ik_table import pose_label
 
 MAX_TILT_DEG = 10.0  # [deg] a taught pose's tool must point down within this to be used (tables use exactly down)
 MAX_APPROACH_M = 0.5  # [m] largest approach height a fit may give

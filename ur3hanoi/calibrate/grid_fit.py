@@ -27,10 +27,10 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.grid import ABOVE, R_world_tcp_down
-from ur3hanoi.labfile import Slot
-from ur3hanoi.robot import load_ur3
-from ur3hanoi.station import Station
+from ur3hanoi.robot.model import load_ur3
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import ABOVE, R_world_tcp_down
+from ur3hanoi.tables import Slot
 
 BoolArray = npt.NDArray[np.bool_]
 

@@ -59,8 +59,8 @@ from ur3hanoi.calibrate.grid_fit import (
     rotation_error_deg,
     solve,
 )
-from ur3hanoi.labfile import Slot
-from ur3hanoi.station import Station
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.tables import Slot
 
 MIN_SUSPECT_MM = 3.0
 """[mm] a point closer than this to the fitted grid is never suspect (hand recordings scatter by a few mm)."""

@@ -19,7 +19,7 @@ def add(sub: argparse._SubParsersAction) -> None:
                                    "or copied entries) are named and left out, never a reason to stop: the report "
                                    "gives every point's deviation [mm] and the suspects worst first, and the "
                                    "station is written only if the remaining fit is sound. Towers and heights are "
-                                   "numbered from 1. See `ur3hanoi.taught` for the file format.")
+                                   "numbered from 1. See `ur3hanoi.calibrate.taught` for the file format.")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--taught", metavar="FILE", help="taught-points YAML (units: deg|rad; points: [...])")
     src.add_argument("--from-table", metavar="FILE", help="lab-format table whose entries are the taught points")
@@ -40,11 +40,11 @@ def run(args: argparse.Namespace) -> int:
 
     from ur3hanoi.audit import audit_taught
     from ur3hanoi.calibrate import fit_station, write_calibration
+    from ur3hanoi.calibrate.taught import load_taught, taught_from_recorded
     from ur3hanoi.io.atomic import check_output
     from ur3hanoi.io.schema import Text
-    from ur3hanoi.labfile import read_recorded_table
-    from ur3hanoi.station import load_station
-    from ur3hanoi.taught import load_taught, taught_from_recorded
+    from ur3hanoi.station.calibration import load_station
+    from ur3hanoi.tables import read_recorded_table
 
     if args.from_table is not None and args.key is None:
         raise UsageError(f"--from-table needs --key ({' or '.join(TABLE_KEYS)})")

@@ -52,8 +52,8 @@ def run(args: argparse.Namespace) -> int:
     import json
 
     from ur3hanoi.audit import STRICT_DEG, STRICT_MM, audit_table, check_against, default_base
-    from ur3hanoi.labfile import read_recorded_table
-    from ur3hanoi.station import load_station
+    from ur3hanoi.station.calibration import load_station
+    from ur3hanoi.tables import read_recorded_table
 
     if args.base is not None and not args.fit:
         raise UsageError("--base is only used with --fit")

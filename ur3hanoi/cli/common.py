@@ -20,7 +20,7 @@ def calibration_ref(arg: str | None) -> str:
 
 def input_file(ref: str) -> Path:
     """The file behind a calibration argument (a shipped station name or a path)."""
-    from ur3hanoi.resources import station_file
+    from ur3hanoi.io.resources import station_file
 
     return station_file(ref)
 
@@ -44,8 +44,8 @@ def shown(path: Any) -> str:
 
 
 SUCTION_PROFILES: tuple[str, ...] = ("lab_sim", "real")
-"""The names of :data:`ur3hanoi.suction_profile.PROFILES` for ``--suction-profile``, spelt out so that building the
-parser does not import the profiles (tests/test_cli_startup.py checks that both are the same)."""
+"""The names of :data:`ur3hanoi.station.suction_profile.PROFILES` for ``--suction-profile``, spelt out so that building
+the parser does not import the profiles (tests/cli/test_startup.py checks that both are the same)."""
 
 
 def add_suction_profile_option(p: Any) -> None:

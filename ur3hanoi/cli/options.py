@@ -20,8 +20,8 @@ class UsageError(Ur3HanoiError):
 
 
 TABLE_KEYS: tuple[str, ...] = ("sim_pos", "real_pos")
-"""The lab file's table keys for ``--key``: :data:`ur3hanoi.labfile.TABLE_KEYS` spelt out, so that building the
-parser does not load numpy (tests/test_cli_startup.py checks that both are the same)."""
+"""The lab file's table keys for ``--key``: :data:`ur3hanoi.tables.TABLE_KEYS` spelt out, so that building the
+parser does not load numpy (tests/cli/test_startup.py checks that both are the same)."""
 
 MAX_BLOCKS = 10
 """Most blocks a plan or a solve takes (1023 moves)."""

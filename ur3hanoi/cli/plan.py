@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
     import json
 
     from ur3hanoi.plan import PlanConfig, plan_json_dict, plan_solve, trajectory_csv
-    from ur3hanoi.station import load_station
+    from ur3hanoi.station.calibration import load_station
 
     inputs = [input_file(calibration_ref(args.calibration))]
     if args.csv or args.html:

@@ -1,6 +1,6 @@
 """What the station and solve subcommands of both middlewares share (:mod:`ur3hanoi.cli.ros`,
 :mod:`ur3hanoi.cli.ros2`): their common options, the station options they build, the "stopped" line, and the
-solve's table, towers, outcome and exit handling around a connected arm (:mod:`ur3hanoi.remote`).
+solve's table, towers, outcome and exit handling around a connected arm (:mod:`ur3hanoi.interface`).
 
 Conventions as in the other subcommands: towers, heights, blocks and grasps numbered from 1; errors one line with
 exit code 2; a suction fault exits with 3 (after printing the ``--json`` outcome).
@@ -94,7 +94,7 @@ def check_station_outputs(args: argparse.Namespace, default_calibration: str) ->
 
 
 def station_options(args: argparse.Namespace, default_calibration: str, report: Path | None) -> dict[str, Any]:
-    """The :class:`ur3hanoi.remote.station.CoreOptions` fields of the common options (numbers from 0)."""
+    """The :class:`ur3hanoi.interface.server.CoreOptions` fields of the common options (numbers from 0)."""
     return {"calibration": args.calibration or default_calibration, "start": args.start - 1,
             "n_blocks": args.blocks, "removed": None if args.remove_block is None else args.remove_block - 1,
             "drop_on_grasp": None if args.drop_on_grasp is None else args.drop_on_grasp - 1, "seed": args.seed,
@@ -163,10 +163,10 @@ def solve_job(args: argparse.Namespace, command: str, default_calibration: str, 
     import numpy as np
 
     from ur3hanoi.hanoi import validate_instance
-    from ur3hanoi.labfile import read_recorded_table
-    from ur3hanoi.robot import Q_HOME_LAB
-    from ur3hanoi.station import load_station
-    from ur3hanoi.waypoints import generate_table
+    from ur3hanoi.robot.model import Q_HOME_LAB
+    from ur3hanoi.station.calibration import load_station
+    from ur3hanoi.tables import read_recorded_table
+    from ur3hanoi.tables.ik_table import generate_table
 
     if args.table is None and args.key is not None:
         raise UsageError("--key is only used with --table (the table is generated from --calibration otherwise)")
@@ -208,13 +208,13 @@ def say_for(args: argparse.Namespace) -> Callable[[str], None]:
 
 def drive(args: argparse.Namespace, arm: Any, job: SolveJob, connected: str,
           outcome: dict[str, object]) -> int:
-    """Connect ``arm`` (a :class:`ur3hanoi.remote.client.TopicArm`), say ``connected``, run the lab's solve,
+    """Connect ``arm`` (a :class:`ur3hanoi.interface.client.TopicArm`), say ``connected``, run the lab's solve,
     close the arm; print the outcome (one JSON object with ``--json``). A suction fault is re-raised (exit 3)
     after its outcome is printed."""
     import json
 
     from ur3hanoi.errors import SuctionFaultError
-    from ur3hanoi.remote.solve import LabSolveConfig, run_lab_solve
+    from ur3hanoi.interface.solve import LabSolveConfig, run_lab_solve
 
     say = say_for(args)
     try:

@@ -65,7 +65,7 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
 
 def _run_station(args: argparse.Namespace) -> int:
     report_file = remote.check_station_outputs(args, DEFAULT_CALIBRATION)  # before any work
-    from ur3hanoi.ros.station import RosStation, StationOptions
+    from ur3hanoi.interface.ros1.server import RosStation, StationOptions
 
     options = StationOptions(**remote.station_options(args, DEFAULT_CALIBRATION, report_file),
                              master_uri=args.master, host=args.host)
@@ -108,7 +108,7 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_solve(args: argparse.Namespace) -> int:
-    from ur3hanoi.ros.client import ArmConfig, RosArm
+    from ur3hanoi.interface.ros1.client import ArmConfig, RosArm
 
     job = remote.solve_job(args, "ros-solve", DEFAULT_CALIBRATION, station_optional=True)
     arm = RosArm(ArmConfig(v=args.v, a=args.a), master_uri=args.master, log=remote.say_for(args))
@@ -134,9 +134,9 @@ def _add_env(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_env(args: argparse.Namespace) -> int:
-    from ur3hanoi.ros.env import default_cache_dir, env_lines
-    from ur3hanoi.ros.master import MasterUri, master_uri_from_env
-    from ur3hanoi.ros.msgs import write_client_env
+    from ur3hanoi.interface.ros1.env import default_cache_dir, env_lines
+    from ur3hanoi.interface.ros1.master import MasterUri, master_uri_from_env
+    from ur3hanoi.interface.ros1.msgs import write_client_env
 
     folder = Path(args.dir).resolve() if args.dir else default_cache_dir()
     uri = args.master or master_uri_from_env()

@@ -74,7 +74,7 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
 
 def _run_station(args: argparse.Namespace) -> int:
     report_file = remote.check_station_outputs(args, DEFAULT_ROS2_CALIBRATION)  # before any work
-    from ur3hanoi.ros2.station import Ros2Station, Ros2StationOptions
+    from ur3hanoi.interface.ros2.server import Ros2Station, Ros2StationOptions
 
     options = Ros2StationOptions(**remote.station_options(args, DEFAULT_ROS2_CALIBRATION, report_file),
                                  timing=args.timing, convention=args.convention, network=args.network,
@@ -96,9 +96,9 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_solve(args: argparse.Namespace) -> int:
-    from ur3hanoi.remote.errors import RosError
-    from ur3hanoi.ros2.client import Ros2Arm, Ros2ArmConfig
-    from ur3hanoi.ros2.dds import domain_id_from_env
+    from ur3hanoi.interface.errors import RosError
+    from ur3hanoi.interface.ros2.client import Ros2Arm, Ros2ArmConfig
+    from ur3hanoi.interface.ros2.dds import domain_id_from_env
 
     job = remote.solve_job(args, "ros2-solve", DEFAULT_ROS2_CALIBRATION, station_optional=False)
     try:

@@ -256,20 +256,20 @@ def run(args: argparse.Namespace) -> int:
 
     from ur3hanoi.hanoi import validate_instance
     from ur3hanoi.plan import PlanConfig, plan_solve, plan_table
-    from ur3hanoi.station import load_station
+    from ur3hanoi.station.calibration import load_station
 
     _check_render_options(args)
     cal = _table_calibration(args)
     inputs = [input_file(cal)]
     station = load_station(cal)
     if args.suction_profile is not None:
-        from ur3hanoi.station import with_suction_profile
+        from ur3hanoi.station.calibration import with_suction_profile
 
         station = with_suction_profile(station, args.suction_profile)
     table = recorded = None
     if args.table is not None:
-        from ur3hanoi.labfile import read_recorded_table
         from ur3hanoi.plan import check_table_shape
+        from ur3hanoi.tables import read_recorded_table
 
         inputs.append(Path(args.table))
         # Entries may be missing (null, or no "above" list) as students record them: the entries the solve visits

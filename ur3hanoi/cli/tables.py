@@ -27,20 +27,22 @@ def add(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ur3hanoi.io.atomic import check_output
-    from ur3hanoi.labfile.generated import generate_key
-    from ur3hanoi.labfile.update import write_sections
+    from ur3hanoi.station.calibration import load_station
+    from ur3hanoi.tables.ik_table import generate_table
+    from ur3hanoi.tables.write import write_table
 
     inputs = [input_file(args.calibration)]
     check_output(args.output, inputs=inputs)  # fail before the IK, not after
-    # An output file that is not YAML, or not a mapping of keys, is refused by write_sections before it writes (the
-    # IK of a table takes about a millisecond: reading the file twice would cost more than it saves). The generated
-    # key comes from the user's cache when the same calibration and ur3hanoi made it before: no NumPy then.
-    gen = generate_key(args.calibration, args.key, args.solver, args.convention,
-                       label=Path(args.calibration).as_posix())
-    write_sections(args.output, gen.sections, inputs=inputs)
+    # An output file that is not YAML, or not a mapping of keys, is refused by the write before it writes (the IK of
+    # a table takes about a millisecond: reading the file twice would cost more than it saves).
+    station = load_station(args.calibration)
+    table = generate_table(station, args.solver)
+    write_table(args.output, table, args.key, Path(args.calibration).as_posix(), inputs=inputs,
+                convention=args.convention)
+    refined = sum(r.iterations > 0 for r in table.results)
     print(
-        f"wrote {args.key} ({gen.n_towers} towers x {gen.n_heights} heights x 2) to {shown(args.output)}: "
-        f"max IK error {gen.max_position_error:.2e} m, {gen.max_orientation_error:.2e} rad (closed form, "
-        f"{gen.refined} of {gen.n_poses} poses refined by {gen.solver})"
+        f"wrote {args.key} ({station.n_towers} towers x {station.n_heights} heights x 2) to {shown(args.output)}: "
+        f"max IK error {table.max_position_error:.2e} m, {table.max_orientation_error:.2e} rad (closed form, "
+        f"{refined} of {len(table.results)} poses refined by {table.solver})"
     )
     return 0

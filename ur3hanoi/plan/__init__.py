@@ -16,7 +16,7 @@ Package map (dependencies flow downward only; each module is one concept):
   :mod:`~ur3hanoi.plan.motion.legs` approach/retreat legs through interior IK points of the line (method there);
   :mod:`~ur3hanoi.plan.motion.via` the search for a connection's via states at the above poses;
   :mod:`~ur3hanoi.plan.motion.blend` the motion across starting inside the 2 mm corridor.
-- :mod:`~ur3hanoi.plan.waypoints`: :func:`build_waypoints`: home, the IK table and every slot's vertical path.
+- :mod:`~ur3hanoi.plan.motion.waypoints`: :func:`build_waypoints`: home, the IK table and every slot's vertical path.
 - ``route/``: from dwell to dwell. :mod:`~ur3hanoi.plan.route.connections` the best connection of two slots and
   the per-station cache; :mod:`~ur3hanoi.plan.route.builder` the hops of a move sequence (rising over taller towers)
   and their chained segments.
@@ -44,7 +44,7 @@ CONTRACT (shared with ur3hanoi.sim; keep these names and meanings):
   honest baseline), ``config``.
 
 Limits: velocity from the UR3 datasheet (``JointLimits.ur3().v_max``: pi rad/s joints 1-3, 2pi rad/s joints 4-6);
-acceleration 4/8 rad/s^2 and jerk 500/1000 rad/s^3 (joints 1-3 / 4-6, ``ur3hanoi.robot.DEFAULT_JERK_MAX``: the
+acceleration 4/8 rad/s^2 and jerk 500/1000 rad/s^3 (joints 1-3 / 4-6, ``ur3hanoi.robot.model.DEFAULT_JERK_MAX``: the
 ``JointLimits`` defaults; UR does not publish them). ``PlanConfig.speed`` scales all three; each can be
 overridden. Every sample is checked against them, against what the suction holds while carrying
 (:func:`~ur3hanoi.plan.checks.suction.check_suction_hold`, ``PlanConfig.suction_hold_mps2``), every sample of a
@@ -56,8 +56,8 @@ Speed (see ``bench/REPORT.md``): the motion is measured against the honest stop-
 Ruckig from rest to rest between the same waypoints, same limits and dwells: ``Plan.stop_and_go_duration_s``);
 the exact-vertical stop-and-go the project used to compare with is ``Plan.exact_vertical_stop_and_go_duration_s``.
 
-Names of :mod:`ur3hanoi.labfile.visits` and :mod:`~ur3hanoi.plan.table_plan` are loaded on first use: a plan of a
-station does not read lab files, and importing ``ur3hanoi.labfile`` (its reader and writer) is a tenth of a cold
+Names of :mod:`ur3hanoi.tables.visits` and :mod:`~ur3hanoi.plan.table_plan` are loaded on first use: a plan of a
+station does not read lab files, and importing ``ur3hanoi.tables`` (its reader and writer) is a tenth of a cold
 ``ur3hanoi plan``'s imports.
 """
 
@@ -71,7 +71,7 @@ from ur3hanoi.plan.export import plan_json_dict, trajectory_csv
 from ur3hanoi.plan.kinematics import tcp_positions_world
 from ur3hanoi.plan.motion.ruckig import OfflineRuckig, RuckigSolution, control_samples, to_pose, to_rest
 from ur3hanoi.plan.motion.sampling import sample
-from ur3hanoi.plan.motion.vertical import VerticalPath
+from ur3hanoi.plan.motion.waypoints import Waypoints, build_waypoints
 from ur3hanoi.plan.planner import plan_moves, plan_solve
 from ur3hanoi.plan.types import (
     DEFAULT_VIA_ACCELS,
@@ -85,15 +85,15 @@ from ur3hanoi.plan.types import (
     PlanConfig,
     Segment,
     Trajectory,
+    VerticalPath,
 )
-from ur3hanoi.plan.waypoints import Waypoints, build_waypoints
 
 if TYPE_CHECKING:
-    from ur3hanoi.labfile.visits import entries_visited, entry_label, missing_entries
     from ur3hanoi.plan.table_plan import check_table_shape, plan_table
+    from ur3hanoi.tables.visits import entries_visited, entry_label, missing_entries
 
-_LAZY = {"entries_visited": "ur3hanoi.labfile.visits", "entry_label": "ur3hanoi.labfile.visits",
-         "missing_entries": "ur3hanoi.labfile.visits", "check_table_shape": "ur3hanoi.plan.table_plan",
+_LAZY = {"entries_visited": "ur3hanoi.tables.visits", "entry_label": "ur3hanoi.tables.visits",
+         "missing_entries": "ur3hanoi.tables.visits", "check_table_shape": "ur3hanoi.plan.table_plan",
          "plan_table": "ur3hanoi.plan.table_plan"}
 
 

@@ -9,8 +9,8 @@ from functools import lru_cache
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.robot import load_ur3
-from ur3hanoi.station import Station
+from ur3hanoi.robot.model import load_ur3
+from ur3hanoi.station.calibration import Station
 
 
 @lru_cache(maxsize=32)

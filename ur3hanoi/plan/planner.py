@@ -18,10 +18,10 @@ from ur3hanoi.plan.checks.stored import check_segments
 from ur3hanoi.plan.checks.suction import check_suction_hold
 from ur3hanoi.plan.checks.vertical import check_vertical
 from ur3hanoi.plan.motion.sampling import sample
+from ur3hanoi.plan.motion.waypoints import build_waypoints
 from ur3hanoi.plan.route.builder import SegmentBuilder, plan_hops
 from ur3hanoi.plan.types import Plan, PlanConfig
-from ur3hanoi.plan.waypoints import build_waypoints
-from ur3hanoi.station import Station
+from ur3hanoi.station.calibration import Station
 
 
 def plan_moves(station: Station, moves: Sequence[Move], config: PlanConfig | None = None, *, start: int = 0,

@@ -34,15 +34,15 @@ from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError, TableError, printable
-from ur3hanoi.grid import ABOVE, ON
 from ur3hanoi.hanoi import check_sequence, solve_hanoi, validate_instance
-from ur3hanoi.labfile.visits import entry_label, require_entries
 from ur3hanoi.plan.checks.limits import check_limits
 from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 from ur3hanoi.plan.motion.sampling import sample
 from ur3hanoi.plan.types import Phase, Plan, PlanConfig, Segment
-from ur3hanoi.robot import N_JOINTS
-from ur3hanoi.station import Station
+from ur3hanoi.robot.model import N_JOINTS
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import ABOVE, ON
+from ur3hanoi.tables.visits import entry_label, require_entries
 
 
 def _target(tower: int, height: int, k: int) -> str:

@@ -9,7 +9,7 @@ import itertools
 import math
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import TYPE_CHECKING
+from functools import cached_property
 
 import numpy as np
 import numpy.typing as npt
@@ -18,12 +18,8 @@ from ruckig import Trajectory as RuckigTrajectory
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
 from ur3hanoi.hanoi import Move
-from ur3hanoi.plan.motion.limits import KinematicLimits
-from ur3hanoi.robot import N_JOINTS
-from ur3hanoi.station import Station
-
-if TYPE_CHECKING:
-    from ur3hanoi.plan.motion.vertical import VerticalPath
+from ur3hanoi.robot.model import N_JOINTS
+from ur3hanoi.station.calibration import Station
 
 # The via grid at the above poses (see ur3hanoi.plan.motion.legs): path speeds in units of vb = L / T0 and path
 # accelerations in units of vb / T0 (L: approach length, T0: the slot's joint-space rest-to-rest leg). The lab
@@ -62,6 +58,65 @@ VERTICAL_PHASES = (Phase.DESCEND_PICK, Phase.LIFT, Phase.DESCEND_PLACE, Phase.RE
 DWELL_PHASES = (Phase.GRASP_DWELL, Phase.RELEASE_DWELL)
 # Commanded suction: on from the grasp dwell until the block is on its destination.
 SUCTION_PHASES = (Phase.GRASP_DWELL, Phase.LIFT, Phase.CARRY, Phase.DESCEND_PLACE)
+
+
+@dataclass(frozen=True)
+class KinematicLimits:
+    """Per-joint limits used for planning [rad/s, rad/s^2, rad/s^3], already scaled by ``PlanConfig.speed``."""
+
+    v_max: FloatArray
+    a_max: FloatArray
+    j_max: FloatArray
+
+
+@dataclass(frozen=True)
+class VerticalPath:
+    """The vertical line of one grid slot as a joint-space path ``q(s)``, ``s`` [m] = distance below "above".
+
+    Nodes every <= ``node_step_m`` by closed-form IK on the home branch (the end nodes are the table's entries);
+    ``q(s)`` between nodes is the cubic Hermite interpolant of (q, dq/ds), accurate to ~1e-10 rad.
+
+    Attributes:
+        s: (M,) node abscissae [m], 0 = above, length_m = on.
+        q: (M, 6) joint angles [rad].
+        dq: (M, 6) dq/ds [rad/m] (exact: J^-1 of a straight-down unit twist).
+        ddq, dddq: (M, 6) d2q/ds2 [rad/m^2], d3q/ds3 [rad/m^3] by finite differences of dq/ds.
+        length_m: approach length [m].
+    """
+
+    s: FloatArray
+    q: FloatArray
+    dq: FloatArray
+    ddq: FloatArray
+    dddq: FloatArray
+    length_m: float
+
+    @cached_property
+    def derivative_bounds(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Per-joint ``max |d^k q / ds^k|`` over the nodes for k = 1, 2, 3 (computed once per path: the waypoints,
+        and so their paths, are cached per station while every plan derives its path limits from these)."""
+        return (np.max(np.abs(self.dq), axis=0), np.max(np.abs(self.ddq), axis=0),
+                np.max(np.abs(self.dddq), axis=0))
+
+    def evaluate(self, s: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """(q, dq/ds, d2q/ds2, d3q/ds3) at ``s`` [m] (clamped to [0, length_m]): a cubic Hermite spline through
+        the IK nodes for q and dq/ds, linear for the higher derivatives."""
+        q, dq, ddq, dddq = self.evaluate_many(np.array([s], dtype=float))
+        return q[0], dq[0], ddq[0], dddq[0]
+
+    def evaluate_many(self, s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """:meth:`evaluate` at every ``s`` (N,) [m] at once: four (N, 6) arrays, with the same arithmetic."""
+        s = np.minimum(np.maximum(s, 0.0), self.length_m)
+        k = np.minimum(np.searchsorted(self.s, s, side="right") - 1, len(self.s) - 2)
+        h = (self.s[k + 1] - self.s[k])[:, None]
+        u = (s[:, None] - self.s[k][:, None]) / h
+        q0, q1, m0, m1 = self.q[k], self.q[k + 1], self.dq[k] * h, self.dq[k + 1] * h
+        u2, u3 = u * u, u * u * u
+        q = (2 * u3 - 3 * u2 + 1) * q0 + (u3 - 2 * u2 + u) * m0 + (-2 * u3 + 3 * u2) * q1 + (u3 - u2) * m1
+        dq = ((6 * u2 - 6 * u) * q0 + (3 * u2 - 4 * u + 1) * m0 + (-6 * u2 + 6 * u) * q1 + (3 * u2 - 2 * u) * m1) / h
+        ddq = (1 - u) * self.ddq[k] + u * self.ddq[k + 1]
+        dddq = (1 - u) * self.dddq[k] + u * self.dddq[k + 1]
+        return q, dq, ddq, dddq
 
 
 @dataclass(frozen=True)
@@ -174,7 +229,7 @@ class Segment:
     ``trajectory`` is the Ruckig trajectory of the segment (time 0 = ``t_start``), None for a dwell at rest at
     ``q_start``. Usually 6-DoF in joint space; for a vertical leg that follows the line exactly (the rest-to-rest
     fallback of :mod:`ur3hanoi.plan.motion.legs`) ``path`` is set and ``trajectory`` is the 1-DoF Ruckig trajectory
-    of the path coordinate s [m] (see :class:`ur3hanoi.plan.motion.vertical.VerticalPath`). ``target`` names the
+    of the path coordinate s [m] (see :class:`VerticalPath`). ``target`` names the
     waypoint reached at the segment's end (1-based tower/height): ``above``, ``on``, ``over`` (risen over taller
     towers), ``via`` (an interior point of a vertical leg) or ``home``.
     """

@@ -21,8 +21,8 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.audit import AuditEntry, AuditReport
-from ur3hanoi.grid import ABOVE, ON
 from ur3hanoi.plots.figure import require_matplotlib, save_figure
+from ur3hanoi.station.grid import ABOVE, ON
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -22,7 +22,7 @@ from meshcat.path import Path as McPath
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.replay.recorder import PoseTrack
 from ur3hanoi.sim.scene import slot_centers
-from ur3hanoi.station import Station
+from ur3hanoi.station.calibration import Station
 
 ROOT = McPath(("meshcat", "ur3hanoi"))
 """Where the replay's objects live in meshcat's scene tree."""

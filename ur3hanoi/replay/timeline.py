@@ -14,7 +14,7 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.hanoi import block_colour
 from ur3hanoi.plan.types import Plan
 from ur3hanoi.sim.result import SimResult
-from ur3hanoi.suction_profile import SuctionProfile
+from ur3hanoi.station.suction_profile import SuctionProfile
 
 FAULT_KINDS = ("missing", "dropped")
 """Feedback event kinds that halt a run."""

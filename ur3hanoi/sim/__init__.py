@@ -24,7 +24,7 @@ Modules, in order of dependency (each imports only the ones above it):
 
 Frames: MuJoCo's world is the station's world. The URDF root ``base_link`` is placed at
 ``T_world_base * Rz(pi)`` so that MuJoCo's ``suction`` site equals ``T_world_base * Ur3Model.fk(q, "tcp")``.
-Joint values are the controller/DH convention (they equal the URDF's, see :mod:`ur3hanoi.robot`).
+Joint values are the controller/DH convention (they equal the URDF's, see :mod:`ur3hanoi.robot.model`).
 
 Numbering: internally 0-based (towers, heights, blocks, moves); messages and JSON are 1-based like the lab.
 """

@@ -4,13 +4,13 @@
 (bodies ``base_link`` .. ``wrist_3_link``, ``ee_link`` with the ``suction_cup`` body and ``suction`` site,
 ``tool0``; joints ``shoulder_pan_joint`` ..; position actuators ``shoulder_pan`` ..; the ``floor`` plane and a
 light as in ``scene.xml``), so the task scene (:mod:`ur3hanoi.sim.scene`) edits either model the same way. Link
-placements are the UR URDF layout of the robot's DH table (:func:`ur3hanoi.robot_urdf.ur_layout`); the visual and
-collision shapes are the primitive cylinders of :func:`ur3hanoi.robot_urdf.link_shapes` (in the e-Series' blue
+placements are the UR URDF layout of the robot's DH table (:func:`ur3hanoi.robot.urdf.ur_layout`); the visual and
+collision shapes are the primitive cylinders of :func:`ur3hanoi.robot.urdf.link_shapes` (in the e-Series' blue
 and grey, so it is never mistaken for the UR3's meshes), and the masses, centres of mass and inertias are
-:func:`ur3hanoi.robot_urdf.link_inertias` (UR's published dynamics parameters). Drives: the UR3 model's gains and
+:func:`ur3hanoi.robot.urdf.link_inertias` (UR's published dynamics parameters). Drives: the UR3 model's gains and
 armature (:data:`ur3hanoi.sim.model.DRIVES`) with the robot's datasheet torque limits.
 
-:func:`write_dh_robot_files` writes the model as ``<robot>.xml`` into its folder under ``ur3hanoi/robots`` (for
+:func:`write_dh_robot_files` writes the model as ``<robot>.xml`` into its folder under ``ur3hanoi/robot/models`` (for
 viewing with ``python -m mujoco.viewer``); the simulator always builds it from the description.
 """
 
@@ -23,9 +23,9 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 
-from ur3hanoi.robot import JOINT_NAMES, Q_HOME_LAB
-from ur3hanoi.robot_registry import RobotDescription
-from ur3hanoi.robot_urdf import LINKS, link_inertias, link_shapes, ur_layout
+from ur3hanoi.robot.model import JOINT_NAMES, Q_HOME_LAB
+from ur3hanoi.robot.registry import RobotDescription
+from ur3hanoi.robot.urdf import LINKS, link_inertias, link_shapes, ur_layout
 from ur3hanoi.sim.model import DEFAULT_TOOL, DRIVES, T_ee_tcp, cup_geometry, quat_wxyz
 
 _LINK_RGBA = {  # e-Series: blue joint caps, grey tubes
@@ -107,8 +107,8 @@ def build_dh_robot_spec(robot: RobotDescription) -> mujoco.MjSpec:
 
 
 def robot_dir_for(robot: RobotDescription) -> Path:
-    """The robot's folder under ``ur3hanoi/robots``."""
-    from ur3hanoi.resources import robots_dir
+    """The robot's folder under ``ur3hanoi/robot/models``."""
+    from ur3hanoi.io.resources import robots_dir
 
     return robots_dir() / robot.mjcf_dir
 

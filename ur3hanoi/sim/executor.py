@@ -34,7 +34,7 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import SimulationError, SuctionFaultError
 from ur3hanoi.hanoi import block_colour
 from ur3hanoi.plan import Phase, Plan, Trajectory
-from ur3hanoi.robot import JOINT_NAMES, N_JOINTS
+from ur3hanoi.robot.model import JOINT_NAMES, N_JOINTS
 from ur3hanoi.sim.diagnosis import displaced_blocks, missed_grasp, missing_block
 from ur3hanoi.sim.halt import DEFAULT_HALT_PROFILE, HaltProfile
 from ur3hanoi.sim.result import DisplacedBlock, FeedbackEvent, FinalBlock, JointTrace, SimResult

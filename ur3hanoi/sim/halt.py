@@ -14,7 +14,7 @@ import numpy as np
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import SimulationError
 from ur3hanoi.plan import KinematicLimits, control_samples, to_pose, to_rest
-from ur3hanoi.station import Station
+from ur3hanoi.station.calibration import Station
 
 
 class HaltProfile(Protocol):

@@ -32,8 +32,8 @@ import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import SimulationError
-from ur3hanoi.resources import robot_dir
-from ur3hanoi.robot import JOINT_NAMES, Q_HOME_LAB, ToolOffset, load_ur3, package_dir, urdf_path
+from ur3hanoi.io.resources import robot_dir
+from ur3hanoi.robot.model import JOINT_NAMES, Q_HOME_LAB, ToolOffset, load_ur3, package_dir, urdf_path
 
 ROBOT_DIR = robot_dir()
 UR3_XML = ROBOT_DIR / "ur3.xml"

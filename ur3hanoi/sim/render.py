@@ -31,7 +31,7 @@ import numpy as np
 from ur3hanoi.errors import OutputError, SimulationError, Ur3HanoiError, printable, quote
 from ur3hanoi.io.atomic import PendingDir, PendingFile, check_output, check_output_dir
 from ur3hanoi.sim.scene import slot_centers
-from ur3hanoi.station import Station
+from ur3hanoi.station.calibration import Station
 
 
 @dataclass(frozen=True)

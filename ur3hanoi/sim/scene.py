@@ -23,11 +23,11 @@ import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import SimulationError
-from ur3hanoi.grid import block_center_world, table_z
 from ur3hanoi.hanoi import block_colour
-from ur3hanoi.robot import JOINT_NAMES, T_BASELINK_BASE
+from ur3hanoi.robot.model import JOINT_NAMES, T_BASELINK_BASE
 from ur3hanoi.sim.model import SCENE_XML, T_ee_tcp, cup_geometry, quat_wxyz
-from ur3hanoi.station import Station
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import block_center_world, table_z
 
 BLOCK_RGBA: dict[str, tuple[float, float, float, float]] = {
     "green": (0.1, 0.7, 0.2, 1.0),

@@ -4,7 +4,7 @@
 suction point is within ``grasp_radius`` of where it would be at contact with a block, that block's weld equality
 (added by :func:`ur3hanoi.sim.build_task_spec`) is activated at the current relative pose. :class:`GripperInput`
 is the emulated ``ur3/gripper_input`` sample (``DIGIN`` bit 0 = block held, ``AIN0`` [V], seeded noise), at the
-levels of a :class:`~ur3hanoi.suction_profile.SuctionProfile`: the station calibration's (``suction:`` section;
+levels of a :class:`~ur3hanoi.station.suction_profile.SuctionProfile`: the station calibration's (``suction:`` section;
 the course simulator's levels by default) unless :class:`SuctionConfig` gives one.
 """
 
@@ -17,7 +17,7 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.sim.scene import TaskScene
-from ur3hanoi.suction_profile import SuctionProfile
+from ur3hanoi.station.suction_profile import SuctionProfile
 
 
 @dataclass(frozen=True)

@@ -1,9 +1,9 @@
 """The lab's own program on the same moves: the baseline a plan's speed is judged against.
 
-The course's starter program (``tests/lab2_exec_starter.py``; its waits are described in the course's ROS
+The course's starter program (``tests/support/lab2_exec_starter.py``; its waits are described in the course's ROS
 interface notes) sends one ``movej`` per waypoint at ``v = a = 4``: home, then per move above(src), on(src),
 above(src), above(dst), on(dst), above(dst), and home again. The controller runs each as its synchronised
-trapezoid (:func:`ur3hanoi.remote.movej.plan_movej`, capped at the datasheet speeds and the 4 / 8 rad/s^2 caps of the
+trapezoid (:func:`ur3hanoi.robot.movej.plan_movej`, capped at the datasheet speeds and the 4 / 8 rad/s^2 caps of the
 station's limits). Around the motion the program waits: ``move_arm`` publishes, sleeps one 20 Hz loop period, then
 polls every period until the arm is at the goal and sleeps once more; ``gripper()`` re-sends the current pose with
 the suction changed (at the goal at once: one period); it sleeps 1.0 s after suction on and 0.5 s after suction off.
@@ -17,9 +17,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ur3hanoi.hanoi import Move
-from ur3hanoi.plan.waypoints import build_waypoints
-from ur3hanoi.remote.movej import plan_movej
-from ur3hanoi.station import Station
+from ur3hanoi.plan.motion.waypoints import build_waypoints
+from ur3hanoi.robot.movej import plan_movej
+from ur3hanoi.station.calibration import Station
 
 LAB_V = LAB_A = 4.0  # the starter's movej speed [rad/s] and acceleration [rad/s^2]
 LAB_LOOP_S = 0.05  # its loop period [s] (20 Hz)

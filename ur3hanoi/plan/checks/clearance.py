@@ -30,14 +30,14 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.grid import block_center_world, table_z
 from ur3hanoi.hanoi import Move, stacks_before_moves
 from ur3hanoi.plan.checks.collision import MAX_REPORTED, CollisionScene, clearance_rules, resting_blocks
 from ur3hanoi.plan.motion.sampling import evaluate
+from ur3hanoi.plan.motion.waypoints import geometry_key
 from ur3hanoi.plan.types import KinematicLimits, Phase, PlanConfig, Segment
-from ur3hanoi.plan.waypoints import geometry_key
-from ur3hanoi.robot import N_JOINTS, T_BASELINK_BASE, dh_link
-from ur3hanoi.station import Station
+from ur3hanoi.robot.model import N_JOINTS, T_BASELINK_BASE, dh_link
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import block_center_world, table_z
 
 Slot = tuple[int, int]
 FINEST_S = 1e-3  # [s] intervals are not halved below this: 1 kHz resolution

@@ -20,12 +20,12 @@ import numpy as np
 import numpy.typing as npt
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.cache import collision_geometry
-from ur3hanoi.grid import R_world_tcp_down, block_center_world, table_z
 from ur3hanoi.hanoi import Move, stacks_before_moves
+from ur3hanoi.plan.checks.geometry import robot_geometry
 from ur3hanoi.plan.types import DWELL_PHASES, VERTICAL_PHASES, KinematicLimits, Phase, PlanConfig, Trajectory
-from ur3hanoi.robot import N_JOINTS, load_ur3
-from ur3hanoi.station import Station
+from ur3hanoi.robot.model import N_JOINTS, load_ur3
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import R_world_tcp_down, block_center_world, table_z
 
 if TYPE_CHECKING:
     import pinocchio as pin
@@ -70,7 +70,7 @@ class CollisionScene:
         import coal
         import pinocchio as pin
 
-        from ur3hanoi.robot import T_BASELINK_BASE
+        from ur3hanoi.robot.model import T_BASELINK_BASE
 
         self.station = station
         robot = load_ur3(station.tool, station.limits, station.robot)
@@ -78,17 +78,7 @@ class CollisionScene:
         self.model = robot.model
         self.data = self.model.createData()
 
-        def robot_geometry() -> pin.GeometryModel:
-            gm = pin.buildGeomFromUrdfString(self.model, robot.urdf, pin.COLLISION)
-            for g in gm.geometryObjects:
-                # Convex hulls of the URDF meshes: ~30x faster GJK distances than the triangle BVHs, and a superset
-                # of each mesh, so a distance can only be under-estimated (the check stays conservative).
-                if isinstance(g.geometry, coal.BVHModelBase):
-                    g.geometry.buildConvexRepresentation(False)
-                    g.geometry = g.geometry.convex
-            return gm
-
-        gm = collision_geometry(robot, robot_geometry)  # from the user's cache after the first build
+        gm = robot_geometry(robot)  # from the user's cache after the first build
         self.robot_geoms = list(range(len(gm.geometryObjects)))
         names = [g.name for g in gm.geometryObjects]
         self.base_geom = names.index("base_link_0") if "base_link_0" in names else -1

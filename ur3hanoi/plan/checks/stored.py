@@ -1,4 +1,4 @@
-"""Clearance results kept in the user's cache (:mod:`ur3hanoi.cache`): a plan the cache rebuilt is not re-checked.
+"""Clearance results kept in the user's cache (:mod:`ur3hanoi.io.cache`): a plan the cache rebuilt is not re-checked.
 
 The planner's clearance check (:func:`~ur3hanoi.plan.checks.clearance.check_segments`: the collision scene, then
 every distinct segment against every slot) is a third of a cold plan whose connections come from the cache, and
@@ -12,7 +12,7 @@ violation messages, on disk:
   times and boundary states and every sample of the trajectory (t, q, qd), by their bytes. A plan that differs in
   anything the check reads is a new entry, never an old result.
 - **Entry**: the violation messages as JSON; an entry that does not decode to a list of strings is rebuilt
-  (:func:`ur3hanoi.cache.cached`: atomic, safe when processes race, a corrupt entry ignored and rewritten).
+  (:func:`ur3hanoi.io.cache.cached`: atomic, safe when processes race, a corrupt entry ignored and rewritten).
 - Pinocchio and coal are imported only when the check runs (a cache miss).
 """
 
@@ -28,13 +28,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ur3hanoi.cache import cached, installed_versions
 from ur3hanoi.hanoi import Move
+from ur3hanoi.io.cache import cached, installed_versions
 from ur3hanoi.plan.cache_key import station_inputs
+from ur3hanoi.plan.motion.waypoints import geometry_key
 from ur3hanoi.plan.types import KinematicLimits, PlanConfig, Segment, Trajectory
-from ur3hanoi.plan.waypoints import geometry_key
-from ur3hanoi.robot import load_ur3
-from ur3hanoi.station import Station
+from ur3hanoi.robot.model import load_ur3
+from ur3hanoi.station.calibration import Station
 
 CLEARANCE = "plan-clearance"
 """Kind of the cache entries of :func:`check_segments`."""

@@ -11,7 +11,7 @@ import numpy as np
 
 from ur3hanoi.plan.kinematics import tcp_accelerations_world
 from ur3hanoi.plan.types import Phase, Trajectory
-from ur3hanoi.station import Station
+from ur3hanoi.station.calibration import Station
 
 GRAVITY_WORLD = np.array([0.0, 0.0, -9.81])  # [m/s^2]
 

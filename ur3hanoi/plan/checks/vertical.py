@@ -11,12 +11,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ur3hanoi.grid import contact_point_world
 from ur3hanoi.hanoi import Move
 from ur3hanoi.plan.kinematics import tcp_positions_world
 from ur3hanoi.plan.motion.vertical import place_band
 from ur3hanoi.plan.types import VERTICAL_PHASES, Phase, Trajectory
-from ur3hanoi.station import Station
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import contact_point_world
 
 
 def check_vertical(tr: Trajectory, moves: Sequence[Move], station: Station, tol_m: float) -> tuple[list[str], float]:

@@ -49,15 +49,15 @@ from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
-from ur3hanoi.grid import ABOVE, ON, contact_point_world
 from ur3hanoi.plan.kinematics import tcp_positions_world
 from ur3hanoi.plan.motion.minimize import nelder_mead
 from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 from ur3hanoi.plan.motion.sampling import evaluate
-from ur3hanoi.plan.motion.vertical import PathLimits, VerticalPath, place_band
-from ur3hanoi.plan.types import KinematicLimits
-from ur3hanoi.plan.waypoints import Waypoints
-from ur3hanoi.station import Station
+from ur3hanoi.plan.motion.vertical import PathLimits, place_band
+from ur3hanoi.plan.motion.waypoints import Waypoints
+from ur3hanoi.plan.types import KinematicLimits, VerticalPath
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import ABOVE, ON, contact_point_world
 
 State = tuple[FloatArray, FloatArray, FloatArray]  # joint position [rad], velocity [rad/s], acceleration [rad/s^2]
 Cell = tuple[int, int]  # (via speed index, via acceleration index)
@@ -69,7 +69,7 @@ DENSE_MARGIN_M = 5e-5
 # [m] a leg may dip this far below the contact pose (see the module docstring). 0.5 mm used to be allowed: at the
 # 500 rad/s^3 jerk a carried block then pressed into the stack below and tilted it, leaving the placed block about
 # 1 mm off per placement in MuJoCo (6 blocks on a 10-level grid ended 7.8 mm off); at 0.2 mm they stay within 2 mm
-# and the lab plans are as fast (tests/test_plan_executes.py, bench/bench_executes.py).
+# and the lab plans are as fast (tests/plan/test_executes.py, bench/bench_executes.py).
 CONTACT_OVERSHOOT_M = 2e-4
 INTERIOR_FRACTIONS: tuple[tuple[float, ...], ...] = ((0.65,), (1 / 3, 2 / 3), (0.25, 0.5, 0.75))  # in order
 LOWER_BOUND_RTOL = 1e-3  # the interior search stops within this of the single-segment lower bound

@@ -5,7 +5,7 @@ the sample falls in. Each DoF's Ruckig profile is 7 constant-jerk phases (``Prof
 ``a`` at each phase start, and after the end); ``at_time`` finds the phase by upper_bound on the cumulative times
 ``t_sum`` and integrates the state from the phase start with ``ruckig::integrate``. :class:`_ProfileTable` does
 the same lookup (with the same sequential sums) and the same arithmetic in the same order, for all samples of
-the plan at once, so the samples equal ``at_time`` bit for bit (``tests/test_plan_sampling.py`` compares them).
+the plan at once, so the samples equal ``at_time`` bit for bit (``tests/plan/motion/test_sampling.py`` compares them).
 Vertical legs map the path coordinate (s, sd, sdd, sddd) to joints by the chain rule through the path's spline
 (:class:`_StackedPaths`, the arithmetic of :meth:`VerticalPath.evaluate` for many paths at once).
 
@@ -27,9 +27,8 @@ import numpy.typing as npt
 from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.plan.motion.vertical import VerticalPath
-from ur3hanoi.plan.types import SUCTION_PHASES, Segment, Trajectory
-from ur3hanoi.robot import N_JOINTS
+from ur3hanoi.plan.types import SUCTION_PHASES, Segment, Trajectory, VerticalPath
+from ur3hanoi.robot.model import N_JOINTS
 
 _N_PIECES = 8  # pieces of a profile: 7 constant-jerk phases and the state after the end
 # Samples per block of the elementwise evaluation. Arrays are joint-major (6, N), so broadcasting a per-sample (N,)

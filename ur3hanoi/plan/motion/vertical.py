@@ -15,17 +15,16 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
-from ur3hanoi.grid import ABOVE, ON, T_base_tcp
-from ur3hanoi.ik import analytic_ik, branch_of, nearest_equivalent
-from ur3hanoi.plan.motion.limits import KinematicLimits
-from ur3hanoi.robot import N_JOINTS, Ur3Model
-from ur3hanoi.station import Station
+from ur3hanoi.plan.types import KinematicLimits, VerticalPath
+from ur3hanoi.robot.ik import analytic_ik, branch_of, nearest_equivalent
+from ur3hanoi.robot.model import N_JOINTS, Ur3Model
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import ABOVE, ON, T_base_tcp
 
 FD_STEP_M = 1e-3  # [m] finite-difference step of the higher path derivatives
 
@@ -49,56 +48,6 @@ def place_band(height: int) -> tuple[float, float] | None:
     """(band above the contact pose [m], allowed distance from the vertical line within it [m]) of a slot at 0-based
     ``height``, or None where no stack is below (:data:`PLACE_BAND_M`, :data:`PLACE_TOL_M`)."""
     return (PLACE_BAND_M, PLACE_TOL_M) if height >= PLACE_MIN_HEIGHT else None
-
-
-@dataclass(frozen=True)
-class VerticalPath:
-    """The vertical line of one grid slot as a joint-space path ``q(s)``, ``s`` [m] = distance below "above".
-
-    Nodes every <= ``node_step_m`` by closed-form IK on the home branch (the end nodes are the table's entries);
-    ``q(s)`` between nodes is the cubic Hermite interpolant of (q, dq/ds), accurate to ~1e-10 rad.
-
-    Attributes:
-        s: (M,) node abscissae [m], 0 = above, length_m = on.
-        q: (M, 6) joint angles [rad].
-        dq: (M, 6) dq/ds [rad/m] (exact: J^-1 of a straight-down unit twist).
-        ddq, dddq: (M, 6) d2q/ds2 [rad/m^2], d3q/ds3 [rad/m^3] by finite differences of dq/ds.
-        length_m: approach length [m].
-    """
-
-    s: FloatArray
-    q: FloatArray
-    dq: FloatArray
-    ddq: FloatArray
-    dddq: FloatArray
-    length_m: float
-
-    @cached_property
-    def derivative_bounds(self) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Per-joint ``max |d^k q / ds^k|`` over the nodes for k = 1, 2, 3 (computed once per path: the waypoints,
-        and so their paths, are cached per station while every plan derives its path limits from these)."""
-        return (np.max(np.abs(self.dq), axis=0), np.max(np.abs(self.ddq), axis=0),
-                np.max(np.abs(self.dddq), axis=0))
-
-    def evaluate(self, s: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """(q, dq/ds, d2q/ds2, d3q/ds3) at ``s`` [m] (clamped to [0, length_m]): a cubic Hermite spline through
-        the IK nodes for q and dq/ds, linear for the higher derivatives."""
-        q, dq, ddq, dddq = self.evaluate_many(np.array([s], dtype=float))
-        return q[0], dq[0], ddq[0], dddq[0]
-
-    def evaluate_many(self, s: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """:meth:`evaluate` at every ``s`` (N,) [m] at once: four (N, 6) arrays, with the same arithmetic."""
-        s = np.minimum(np.maximum(s, 0.0), self.length_m)
-        k = np.minimum(np.searchsorted(self.s, s, side="right") - 1, len(self.s) - 2)
-        h = (self.s[k + 1] - self.s[k])[:, None]
-        u = (s[:, None] - self.s[k][:, None]) / h
-        q0, q1, m0, m1 = self.q[k], self.q[k + 1], self.dq[k] * h, self.dq[k + 1] * h
-        u2, u3 = u * u, u * u * u
-        q = (2 * u3 - 3 * u2 + 1) * q0 + (u3 - 2 * u2 + u) * m0 + (-2 * u3 + 3 * u2) * q1 + (u3 - u2) * m1
-        dq = ((6 * u2 - 6 * u) * q0 + (3 * u2 - 4 * u + 1) * m0 + (-6 * u2 + 6 * u) * q1 + (3 * u2 - 2 * u) * m1) / h
-        ddq = (1 - u) * self.ddq[k] + u * self.ddq[k + 1]
-        dddq = (1 - u) * self.dddq[k] + u * self.dddq[k + 1]
-        return q, dq, ddq, dddq
 
 
 def tangent_down(robot: Ur3Model, R_world_base: FloatArray, q: FloatArray) -> FloatArray:

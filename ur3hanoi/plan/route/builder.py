@@ -28,14 +28,14 @@ import numpy as np
 from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.grid import block_center_world, contact_point_world
 from ur3hanoi.hanoi import Move, stacks_before_moves
 from ur3hanoi.plan.motion.legs import Leg, State
 from ur3hanoi.plan.route import stored
 from ur3hanoi.plan.route.connections import Connection, StationPlanner, station_planner
 from ur3hanoi.plan.types import Phase, PlanConfig, Segment
-from ur3hanoi.robot import N_JOINTS
-from ur3hanoi.station import Station
+from ur3hanoi.robot.model import N_JOINTS
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import block_center_world, contact_point_world
 
 Slot = tuple[int, int]  # (tower, height), 0-based
 Step = tuple[Phase, int]  # (phase, move index) of a segment

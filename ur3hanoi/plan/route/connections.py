@@ -27,16 +27,16 @@ from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
-from ur3hanoi.grid import ABOVE, contact_point_world
 from ur3hanoi.plan.motion.blend import Blender, lateral_direction
 from ur3hanoi.plan.motion.legs import Cell, Leg, SlotLegs, State, within_limits
 from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 from ur3hanoi.plan.motion.vertical import PathLimits, line_ik
 from ur3hanoi.plan.motion.via import Pair, best_cells
+from ur3hanoi.plan.motion.waypoints import Waypoints, build_waypoints, geometry_key
 from ur3hanoi.plan.types import KinematicLimits
-from ur3hanoi.plan.waypoints import Waypoints, build_waypoints, geometry_key
-from ur3hanoi.robot import N_JOINTS, load_ur3
-from ur3hanoi.station import Station
+from ur3hanoi.robot.model import N_JOINTS, load_ur3
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.station.grid import ABOVE, contact_point_world
 
 Slot = tuple[int, int]  # (tower, height), 0-based
 ConnectionKey = tuple[Slot | None, Slot | None, float | None, float | None]  # slot0, slot1, over0, over1

@@ -1,4 +1,4 @@
-"""Connections kept in the user's cache (:mod:`ur3hanoi.cache`), so a new process plans without searching again.
+"""Connections kept in the user's cache (:mod:`ur3hanoi.io.cache`), so a new process plans without searching again.
 
 A connection's search (the via cells, the interior points of its legs, the blends: SciPy's Nelder-Mead over many
 Ruckig calculations, and the 1 kHz corridor checks) is most of a cold plan; its result is a function of the station
@@ -13,7 +13,7 @@ geometry, the robot model and the planning settings alone. :func:`connect` keeps
   versions, the planner's source), the planning limits, corridor, via grid, pass-through and blend settings, and
   the connection (slots and over heights): a changed input or a changed planner is a new entry, never a stale plan.
 - An entry that does not decode, or whose states Ruckig no longer connects, is rebuilt
-  (:func:`ur3hanoi.cache.cached`).
+  (:func:`ur3hanoi.io.cache.cached`).
 """
 
 from __future__ import annotations
@@ -24,11 +24,11 @@ from functools import lru_cache
 
 import numpy as np
 
-from ur3hanoi.cache import cached
+from ur3hanoi.io.cache import cached
 from ur3hanoi.plan.cache_key import station_inputs
 from ur3hanoi.plan.motion.legs import Leg, State
+from ur3hanoi.plan.motion.waypoints import geometry_key
 from ur3hanoi.plan.route.connections import Connection, ConnectionKey, Slot, StationPlanner
-from ur3hanoi.plan.waypoints import geometry_key
 
 CONNECTION = "plan-connection"
 """Kind of the cache entries of :func:`connect`."""

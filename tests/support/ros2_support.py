@@ -1,0 +1,62 @@
+"""Helpers of the ROS 2 tests: every process that starts a DDS participant runs inside a private network namespace
+(``unshare -n``, loopback up with multicast), so no DDS packet can leave the machine, whatever the configuration.
+
+:func:`in_netns` runs one shell script there (station and clients together, since a namespace lives as long as its
+first process); the script's stdout/stderr and exit code come back. Tests skip, saying why, only where a namespace
+cannot be made (no ``unshare``, or not permitted).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _netns_problem() -> str | None:
+    if shutil.which("unshare") is None or shutil.which("ip") is None:
+        return "unshare/ip not installed: cannot make a private network namespace for DDS"
+    try:
+        r = subprocess.run(["unshare", "-n", "sh", "-c", "ip link set lo up && ip link set lo multicast on"],
+                           capture_output=True, text=True, timeout=20)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        return f"unshare -n failed: {exc}"
+    if r.returncode != 0:
+        return f"unshare -n not permitted here ({r.stderr.strip()[:120]}): DDS tests need a private network namespace"
+    return None
+
+
+NETNS_PROBLEM = _netns_problem()
+requires_netns = pytest.mark.skipif(NETNS_PROBLEM is not None, reason=NETNS_PROBLEM or "")
+
+UR3HANOI = f"{sys.executable} -m ur3hanoi.cli"
+
+PRELUDE = """set -u
+ip link set lo up && ip link set lo multicast on
+wait_ready() {  # wait_ready FILE: until the station printed its ready line (60 s at most)
+  for _ in $(seq 1 300); do grep -q "ros2-station: ready" "$1" && return 0; sleep 0.2; done
+  echo "station not ready" >&2; cat "$1" >&2; return 1
+}
+"""
+
+
+def in_netns(script: str, timeout: float, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """Run ``script`` (bash) in a new network namespace; ``$UR3HANOI`` is the CLI. Killed after ``timeout`` [s]."""
+    env = dict(os.environ, UR3HANOI=UR3HANOI, PYTHONUNBUFFERED="1", ROS_DOMAIN_ID="0")
+    proc = subprocess.Popen(["unshare", "-n", "bash", "-c", PRELUDE + script], cwd=cwd, env=env, text=True,
+                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, err = proc.communicate()
+        raise AssertionError(f"netns script did not finish within {timeout} s:\n{out}\n{err}") from None
+    return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)

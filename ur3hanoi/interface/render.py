@@ -1,0 +1,121 @@
+"""Offscreen rendering for a station's ``--frames``/``--video`` (``ros-station``, ``ros2-station``) in a separate,
+low-priority process.
+
+Software EGL renders a 640x480 frame in about 100 ms and holds the interpreter while doing so: inside the control
+process it would stall the 8 ms loop (measured: 200 ms lags). So a child process (``spawn``, niced, Mesa's
+llvmpipe limited to one thread) builds the same task scene and renders the joint state it is sent with
+:class:`ur3hanoi.sim.OffscreenRecorder`; while it is busy, offered states are dropped. A video therefore has the
+frames the machine could render (a few per second with software GL) and plays faster than real time; the control
+loop keeps real time.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+from multiprocessing.connection import Connection
+from pathlib import Path
+from typing import Any
+
+from ur3hanoi.arrays import FloatArray
+from ur3hanoi.interface.errors import RosError
+
+
+def _worker(conn: Connection, calibration: str, n_blocks: int, frames: Path | None, video: Path | None) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the station stops us (a Ctrl-C must not cut the video short)
+    os.environ.setdefault("LP_NUM_THREADS", "1")  # llvmpipe: leave the other core to the control loop
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    os.nice(10)
+    try:
+        import mujoco
+
+        from ur3hanoi.sim import OffscreenRecorder, build_task_scene
+        from ur3hanoi.station.calibration import load_station
+
+        station = load_station(calibration)
+        scene = build_task_scene(station, 0, n_blocks)
+        recorder = OffscreenRecorder(station, scene.model, frames_dir=frames, video=video)
+    except Exception as exc:  # reported to the station, which raises it as one line
+        conn.send(f"error: {' '.join(str(exc).split())}")
+        return
+    conn.send(f"ready {recorder.fps}")
+    try:
+        while True:
+            qpos = conn.recv()
+            if qpos is None:
+                break
+            scene.data.qpos[:] = qpos
+            mujoco.mj_forward(scene.model, scene.data)
+            recorder(scene.model, scene.data)
+            conn.send(recorder.count)
+    finally:
+        recorder.close()
+        conn.send("closed")
+
+
+class FrameProcess:
+    """The rendering child process (see the module docstring). Use :meth:`offer` each frame period, then
+    :meth:`close`.
+
+    Raises:
+        RosError: the child could not set up rendering (its error, one line).
+    """
+
+    def __init__(self, calibration: str, n_blocks: int, frames: Path | None, video: Path | None,
+                 start_timeout_s: float = 120.0) -> None:
+        ctx = multiprocessing.get_context("spawn")  # never fork a process that runs rospy's or DDS threads
+        self._conn, child = ctx.Pipe()
+        self._proc: Any = ctx.Process(target=_worker, args=(child, calibration, n_blocks, frames, video),
+                                      daemon=True, name="ur3hanoi-render")
+        self._proc.start()
+        child.close()
+        self._busy = False
+        self.offered = 0
+        self.dropped = 0
+        self.rendered = 0
+        if not self._conn.poll(start_timeout_s):
+            self._kill()
+            raise RosError(f"the rendering process did not start within {start_timeout_s:g} s")
+        hello = self._conn.recv()
+        if not str(hello).startswith("ready"):
+            self._kill()
+            raise RosError(f"offscreen rendering failed: {str(hello).removeprefix('error: ')}")
+        self.fps = float(str(hello).split()[1])
+
+    def _collect(self) -> None:
+        while self._busy and self._conn.poll():
+            reply = self._conn.recv()
+            if isinstance(reply, int):
+                self.rendered = reply
+                self._busy = False
+
+    def offer(self, qpos: FloatArray) -> None:
+        """Send the state to render unless the child is still busy with the last one (then it is dropped)."""
+        self._collect()
+        if self._busy:
+            self.dropped += 1
+            return
+        self._conn.send(qpos.copy())
+        self._busy = True
+        self.offered += 1
+
+    def close(self, timeout_s: float = 60.0) -> dict[str, int]:
+        """Finish the file (waits for the frame in progress) and stop the child; returns the frame counts."""
+        if self._proc.is_alive():
+            if self._busy and self._conn.poll(timeout_s):
+                self._collect()
+            try:
+                self._conn.send(None)
+                while self._conn.poll(timeout_s) and self._conn.recv() != "closed":
+                    pass
+            except (OSError, EOFError):
+                pass
+            self._proc.join(timeout_s)
+        self._kill()
+        return {"rendered": self.rendered, "dropped": self.dropped}
+
+    def _kill(self) -> None:
+        if self._proc.is_alive():
+            self._proc.kill()
+            self._proc.join(10)

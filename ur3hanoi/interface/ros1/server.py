@@ -1,0 +1,176 @@
+"""``ur3hanoi ros-station``: a drop-in for the course's Gazebo world and ``ur3_driver``, backed by MuJoCo.
+
+The node speaks the course's topics and messages exactly (:mod:`ur3hanoi.interface.ros1.msgs`):
+
+- subscribes ``/ur3/command``: each accepted command runs as the controller's ``movej``
+  (:mod:`ur3hanoi.robot.movej`, ``v``/``a`` capped at the UR3's limits) after the ones before it
+  (:mod:`ur3hanoi.interface.controller`), switching the suction to ``io_0`` when it starts; malformed commands are
+  refused with a logged error and no motion (:mod:`ur3hanoi.interface.command`);
+- publishes ``/ur3/position`` (measured joint angles, ``isReady`` false while moving or not yet within
+  0.0005 rad of the destination) and ``/ur3/gripper_input`` (``DIGIN`` bit 0, ``AIN0`` from the suction model)
+  every control period (8 ms: 125 Hz, like the course driver);
+- subscribes ``/ur3hanoi/spawn`` (``std_msgs/Int32``, tower 1..3: respawn every block there, like
+  ``lab2_spawn.py``) and ``/ur3hanoi/remove_block`` (``std_msgs/Int32``, block 1..3, 1 = bottom/green: take it
+  away; a held block is dropped).
+
+Real time, the bounded inbox, rate-limited logging and the report are the transport-neutral station's
+(:mod:`ur3hanoi.interface.server`); this module binds them to rospy. A roscore is started when none answers at
+``ROS_MASTER_URI`` (:mod:`ur3hanoi.interface.ros1.master`) and stopped on exit, or when the station dies
+(:mod:`ur3hanoi.interface.ros1.guard`).
+
+A flood cannot stall the loop: the ROS callbacks only append to the bounded inbox
+(:data:`~ur3hanoi.interface.server.INBOX_MAX` messages), log lines are rate-limited and the records bounded
+(:class:`~ur3hanoi.interface.server.StationCore`).
+
+Listening: the station and the roscore it starts bind and advertise ``host`` (``ROS_IP``), by default
+``127.0.0.1``: nothing on the lab network can reach them. ``--host ADDR`` (this machine's address on the lab
+network) opens them; a master on another machine needs it. ``ROS_IP``/``ROS_HOSTNAME`` of the environment are
+not used.
+
+Output: the ready line and every info line go to ``info`` (the CLI: stderr); standard output carries only the
+JSON report when there is no ``--report`` file.
+
+``--frames``/``--video`` render in a separate low-priority process (:mod:`ur3hanoi.interface.render`, started by
+:meth:`~ur3hanoi.interface.server.StationCore.rendering`), which drops frames rather than stall the loop.
+
+The JSON report (:meth:`RosStation.report`): commands executed (with duration, settle time and rest error),
+refused, suction events, faults, final block positions (tower/height, or none = off-grid), loop timing, rendered
+frames. It is
+written on SIGINT/SIGTERM and at the end of ``--duration``, and on SIGUSR1 without stopping: to ``--report FILE``
+(atomically) or, without it, to stdout.
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import os
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from ur3hanoi.interface.errors import RosError
+from ur3hanoi.interface.server import CoreOptions, StationCore
+
+READY_LINE = "ur3hanoi ros-station: ready"
+"""Written (and flushed) on stderr once the node is up: scripts wait for it."""
+
+
+@dataclass(frozen=True)
+class StationOptions(CoreOptions):
+    """What ``ur3hanoi ros-station`` runs: :class:`~ur3hanoi.interface.server.CoreOptions` and
+
+    Attributes:
+        master_uri: ROS master (None: ``ROS_MASTER_URI``, else http://localhost:11311).
+        host: address the station and the roscore it starts listen on and advertise (``ROS_IP``); the default
+            127.0.0.1 keeps them on this machine.
+    """
+
+    master_uri: str | None = None
+    host: str = "127.0.0.1"
+
+
+class RosStation(StationCore):
+    """The ``ros-station`` node (see the module docstring). :meth:`run` blocks until stopped.
+
+    Args:
+        options: what to run.
+        out: where the ready line and info lines go (default: print to stderr, flushed).
+        report_out: where the JSON report goes without ``options.report`` (default: print to stdout, flushed).
+    """
+
+    options: StationOptions
+
+    TOPIC_LOG: ClassVar[dict[str, str]] = {"command": "ur3/command rejected, the arm does not move",
+                                           "spawn": "ur3hanoi/spawn", "remove": "ur3hanoi/remove_block"}
+
+    def __init__(self, options: StationOptions, out: Callable[[str], None] | None = None,
+                 report_out: Callable[[str], None] | None = None) -> None:
+        from ur3hanoi.interface.ros1.master import MasterUri, is_loopback, master_uri_from_env
+
+        super().__init__(options, out if out is not None else (lambda s: print(s, file=sys.stderr, flush=True)),
+                         report_out if report_out is not None else (lambda s: print(s, flush=True)))
+        opts = options
+        self.master_uri = opts.master_uri or master_uri_from_env()
+        master = MasterUri.parse(self.master_uri)
+        try:
+            ipaddress.ip_address(opts.host)
+        except ValueError:
+            raise RosError(f"host {opts.host!r} is invalid: expected this machine's IP address (ROS_IP), e.g. "
+                           "127.0.0.1 (default, this machine only) or its address on the lab network") from None
+        if not master.is_local and is_loopback(opts.host):
+            raise RosError(f"the ROS master {self.master_uri} is on another machine, which cannot reach a station "
+                           "listening on loopback only: give --host ADDR, this machine's address on the lab network")
+        self.roscore_started = False
+        self._rospy: Any = None
+
+    # ---------------------------------------------------------------------------------------------- callbacks
+    def _on_spawn(self, msg: Any) -> None:
+        self.on_spawn(msg.data)
+
+    def _on_remove(self, msg: Any) -> None:
+        self.on_remove(msg.data)
+
+    def _emit(self, level: str, text: str) -> None:
+        rospy = self._rospy
+        if rospy is None:
+            self.out(text)
+        else:
+            {"info": rospy.loginfo, "warn": rospy.logwarn}.get(level, rospy.logerr)(text)
+
+    # ------------------------------------------------------------------------------------------------ report
+    def _report_transport(self) -> dict[str, Any]:
+        return {"master_uri": self.master_uri, "roscore_started": self.roscore_started}
+
+    # --------------------------------------------------------------------------------------------------- run
+    def run(self) -> dict[str, Any]:
+        """Start (or use) the master, run the node until SIGINT/SIGTERM or ``duration_s``; returns the report."""
+        from ur3hanoi.interface.ros1.env import import_rospy, import_std_msgs
+        from ur3hanoi.interface.ros1.master import RosCore, listen_env
+        from ur3hanoi.interface.ros1.msgs import load_messages
+
+        msgs = load_messages()
+        rospy = self._rospy = import_rospy()
+        std_msgs = import_std_msgs()
+        # rospy's receiving threads hold the GIL for each message they decode: with the default 5 ms switch
+        # interval a flood of messages can keep the control loop waiting most of an 8 ms period.
+        switch = sys.getswitchinterval()
+        sys.setswitchinterval(min(switch, 0.0005))
+        try:
+            # The rendering process starts before rospy's threads.
+            with self.signals(), self.rendering(), RosCore(self.master_uri, host=self.options.host) as core:
+                self.roscore_started = core.started
+                # rospy reads these from the environment: the master, and the address to bind and advertise.
+                env = listen_env(dict(os.environ, ROS_MASTER_URI=self.master_uri), self.options.host)
+                os.environ.pop("ROS_HOSTNAME", None)
+                os.environ.update(env)
+                rospy.init_node("ur3hanoi_station", argv=[sys.argv[0]], disable_signals=True)
+                pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
+                pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
+                rospy.Subscriber("/ur3/command", msgs.command, self.on_command, queue_size=100)
+                rospy.Subscriber("/ur3hanoi/spawn", std_msgs.Int32, self._on_spawn, queue_size=10)
+                rospy.Subscriber("/ur3hanoi/remove_block", std_msgs.Int32, self._on_remove, queue_size=10)
+                try:
+                    self._run_loop(msgs, pub_pos, pub_grip)
+                finally:
+                    rospy.signal_shutdown("ur3hanoi ros-station stopped")
+                self.close_sink()  # the report has the final frame counts
+                report = self.write_report()
+        finally:
+            sys.setswitchinterval(switch)
+        return report
+
+    def _run_loop(self, msgs: Any, pub_pos: Any, pub_grip: Any) -> None:
+        w, opts = self.world, self.options
+
+        def publish() -> None:
+            fb = w.feedback()
+            pub_pos.publish(msgs.position(position=[float(x) for x in w.q], isReady=self.driver.ready))
+            pub_grip.publish(msgs.gripper_input(DIGIN=fb.digin, AIN0=fb.ain0, AIN1=0.0))
+
+        st = self.station
+        spawned = w.n_blocks - len(w.removed)  # --remove-block leaves one out
+        ready = (f"{READY_LINE} on {self.master_uri}: {st.name}, {spawned} blocks on tower {opts.start + 1}, "
+                 f"{1.0 / w.config.period_s:g} Hz, suction profile {w.cup.profile.name} (pid {os.getpid()})")
+        # The ROS callbacks fill the inbox in rospy's threads: nothing to receive here.
+        self.loop(ready, lambda: None, publish, running=lambda: not self._rospy.is_shutdown())

@@ -1,0 +1,437 @@
+"""The UR3 (CB3) model: URDF location, DH parameters, datasheet limits, and Pinocchio forward kinematics.
+
+Frames (all right-handed, metres):
+
+- ``base``: the UR controller's base frame, the frame of the DH convention. **Every joint value and every
+  ``T_base_*`` pose in ur3hanoi is in this frame**, like the lab's tables and the teach pendant.
+- ``base_link``: the URDF root. It is ``base`` rotated by pi about z (``T_baselink_base = Rz(pi)``).
+- ``tool0``: the flange, z along the tool axis (the DH end frame).
+- ``ee_link``: the flange with x along the tool axis (the course's suction offset is given from it).
+- ``tcp``: the suction point, added to the model from a :class:`ToolOffset`.
+
+Joint values follow the controller convention: the URDF's joint zeros equal the DH zeros, so the same ``q`` [rad]
+drives both; only the root frame differs.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from functools import cache, cached_property
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ur3hanoi.arrays import FloatArray
+from ur3hanoi.errors import Ur3HanoiError
+from ur3hanoi.robot.chain import UrdfChain, parse_chain, rigid_inverse, se3_act_inv
+from ur3hanoi.robot.registry import CB3_CONTROL_PERIOD_S, UR3, DHParameters, RobotDescription
+
+if TYPE_CHECKING:
+    import pinocchio as pin
+
+    T_BASELINK_BASE: pin.SE3
+
+JOINT_NAMES: tuple[str, ...] = (
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+)
+N_JOINTS = 6
+
+# UR3 (CB3) DH parameters [m, rad], from Universal Robots' published DH table.
+DH_D: tuple[float, ...] = (0.1519, 0.0, 0.0, 0.11235, 0.08535, 0.0819)
+DH_A: tuple[float, ...] = (0.0, -0.24365, -0.21325, 0.0, 0.0, 0.0)
+DH_ALPHA: tuple[float, ...] = (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0)
+
+# Controller `base` seen from URDF `base_link`: a half turn about z (as a 4x4 matrix; T_BASELINK_BASE is the same
+# as a pin.SE3, made on first use so that importing this module does not import Pinocchio).
+H_BASELINK_BASE: FloatArray = np.eye(4)
+H_BASELINK_BASE[:2, :2] = [[math.cos(math.pi), -math.sin(math.pi)], [math.sin(math.pi), math.cos(math.pi)]]
+H_BASE_BASELINK: FloatArray = rigid_inverse(H_BASELINK_BASE)
+
+
+@cache
+def _se3(name: str) -> pin.SE3:
+    import pinocchio as pin
+
+    T = pin.SE3(pin.utils.rotate("z", math.pi), np.zeros(3))
+    return T if name == "T_BASELINK_BASE" else T.inverse()
+
+
+def __getattr__(name: str) -> object:
+    """``T_BASELINK_BASE``: :data:`H_BASELINK_BASE` as a ``pin.SE3`` (Pinocchio imported on first use)."""
+    if name == "T_BASELINK_BASE":
+        return _se3(name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+# The lab's home: radians([120, -90, 90, -90, -90, 0]).
+Q_HOME_LAB: tuple[float, ...] = tuple(math.radians(d) for d in (120.0, -90.0, 90.0, -90.0, -90.0, 0.0))
+
+
+# [rad/s^2] Acceleration caps (joints 1-3, wrists): not published by UR; the lab's values (see JointLimits.a_max).
+DEFAULT_ACCEL_MAX: tuple[float, ...] = UR3.a_max
+# [s] The CB3 controller's servo cycle (125 Hz).
+CONTROL_PERIOD_S = CB3_CONTROL_PERIOD_S
+# [rad/s^3] Jerk limits: each acceleration cap reached within one servo cycle, a_max / 8 ms = 500 rad/s^3 (joints
+# 1-3) and 1000 rad/s^3 (wrists). Source: UR publishes no jerk limit and the controller's movej steps its
+# acceleration, which at 125 Hz is exactly such a one-cycle ramp: a planner with a lower jerk is slower than the
+# program it replaces for no physical reason (20/40 rad/s^3 made the plan 4 % slower than the lab program). What
+# this costs the carried block is measured by bench/bench_suction_hold.py (bench/REPORT.md): in MuJoCo the suction
+# weld (0.004 s) stretches at most 0.056 mm on lab_sim and 0.078 mm on lab_real at 100-2000 rad/s^3, against the
+# 10 mm at which the seal counts as broken (SuctionConfig.hold_tolerance): a margin above 100.
+DEFAULT_JERK_MAX: tuple[float, ...] = UR3.j_max  # = a_max / CONTROL_PERIOD_S (the registry's UR3 entry)
+
+
+@dataclass(frozen=True)
+class JointLimits:
+    """UR3 joint limits, from the CB3 datasheet unless stated.
+
+    The URDF of example-robot-data carries UR5-like velocity/effort values: they are deliberately not used.
+
+    Attributes:
+        q_min, q_max: position limits [rad]; datasheet +-2pi on every joint. ROS configs often restrict the elbow
+            to +-pi: pass ``elbow_limit=math.pi`` to :meth:`ur3`.
+        v_max: speed limits [rad/s]; datasheet 180 deg/s for base/shoulder/elbow, 360 deg/s for the wrists.
+        a_max: acceleration limits [rad/s^2]. Not published by UR; default 4 rad/s^2 (joints 1-3) and 8 rad/s^2
+            (wrists) keeps the UR3's 56/28/12 N m torques with margin at the lab's 0.0225 kg payload.
+        j_max: jerk limits [rad/s^3]. Not published by UR: default :data:`DEFAULT_JERK_MAX`, see there.
+    """
+
+    q_min: tuple[float, ...]
+    q_max: tuple[float, ...]
+    v_max: tuple[float, ...]
+    a_max: tuple[float, ...]
+    j_max: tuple[float, ...]
+
+    @classmethod
+    def for_robot(cls, robot: RobotDescription, elbow_limit: float = 2 * math.pi) -> JointLimits:
+        """``robot``'s limits (:mod:`ur3hanoi.robot.registry`): +-2pi on every joint (``elbow_limit`` [rad] on the
+        elbow), its datasheet speeds and the planner's accelerations and jerks."""
+        base = cls.ur3(elbow_limit)
+        return cls(q_min=base.q_min, q_max=base.q_max, v_max=robot.v_max, a_max=robot.a_max, j_max=robot.j_max)
+
+    @classmethod
+    def ur3(cls, elbow_limit: float = 2 * math.pi) -> JointLimits:
+        """Datasheet limits; ``elbow_limit`` [rad] optionally restricts the elbow (ROS configs use pi)."""
+        if not 0.0 < elbow_limit <= 2 * math.pi:
+            raise Ur3HanoiError(f"elbow_limit = {elbow_limit!r} rad is invalid: expected 0 < elbow_limit <= 2*pi")
+        two_pi = 2 * math.pi
+        q_max = (two_pi, two_pi, elbow_limit, two_pi, two_pi, two_pi)
+        return cls(
+            q_min=tuple(-x for x in q_max),
+            q_max=q_max,
+            v_max=(math.pi,) * 3 + (two_pi,) * 3,
+            a_max=DEFAULT_ACCEL_MAX,
+            j_max=DEFAULT_JERK_MAX,
+        )
+
+    def within_position(self, q: FloatArray, tol: float = 1e-12) -> bool:
+        """True when every joint of ``q`` [rad] is inside [q_min, q_max] (with ``tol`` [rad] slack)."""
+        q = np.asarray(q, dtype=float)
+        return bool(np.all(q >= np.asarray(self.q_min) - tol) and np.all(q <= np.asarray(self.q_max) + tol))
+
+
+@dataclass(frozen=True)
+class ToolOffset:
+    """The suction point (TCP) as a fixed offset from a flange frame.
+
+    Attributes:
+        parent: ``"ee_link"`` (x along the tool axis, the course URDF's convention) or ``"tool0"`` (z along it).
+        xyz: translation [m] in the parent frame.
+        rpy: URDF roll-pitch-yaw [rad] (fixed axes x, y, z) of the TCP frame in the parent frame.
+    """
+
+    parent: str = "ee_link"
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+FLANGE_FRAMES: tuple[str, ...] = ("ee_link", "tool0")
+
+
+@cache
+def _erd_share_dir() -> Path:
+    """`cmeel.prefix/share` of the installed example-robot-data, found without importing its loaders.
+
+    The folder of its ``example_robot_data-*.dist-info`` on ``sys.path`` (what ``importlib.metadata`` finds, without
+    the cost of importing it); ``importlib.metadata`` when there is no such folder (another kind of install).
+    """
+    import os
+    import sys
+
+    for entry in sys.path:
+        try:
+            names = os.listdir(entry or ".")
+        except OSError:
+            continue
+        if any(n.startswith("example_robot_data-") and n.endswith(".dist-info") for n in names):
+            return Path(entry or ".").resolve() / "cmeel.prefix" / "share"
+    import importlib.metadata
+
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError as exc:
+        raise Ur3HanoiError(
+            "example-robot-data is not installed: run `make venv` (it installs requirements.lock)"
+        ) from exc
+    return Path(str(dist.locate_file("cmeel.prefix/share")))
+
+
+def urdf_path(robot: RobotDescription = UR3) -> Path:
+    """Path of example-robot-data's ``ur3_robot.urdf`` (loaded by path: some loaders map "ur3" to a UR5), or of
+    ``robot``'s URDF file there."""
+    path = _erd_share_dir() / f"example-robot-data/robots/ur_description/urdf/{robot.urdf_file}"
+    if not path.is_file():
+        raise Ur3HanoiError(f"UR3 URDF not found at {path}: example-robot-data >= 4.4 is required")
+    return path
+
+
+def package_dir() -> Path:
+    """Directory that resolves the URDF's ``package://example-robot-data/...`` mesh URIs."""
+    return _erd_share_dir()
+
+
+def _fmt(x: float) -> str:
+    return repr(float(x))
+
+
+@cache
+def urdf_text(tool: ToolOffset | None = None, absolute_meshes: bool = True, robot: RobotDescription = UR3) -> str:
+    """The UR3 URDF (or ``robot``'s) as text, optionally with a ``tcp`` link fixed to ``tool.parent``.
+
+    ``absolute_meshes`` rewrites ``package://`` URIs to absolute paths (placo and MuJoCo cannot resolve them).
+    A robot described by DH only (``model_source == "dh"``) gets the URDF :mod:`ur3hanoi.robot.urdf` generates.
+    """
+    if robot.model_source == "dh":
+        from ur3hanoi.robot.urdf import urdf_from_dh
+
+        text = urdf_from_dh(robot)
+    else:
+        text = (urdf_path() if robot == UR3 else urdf_path(robot)).read_text()
+    if absolute_meshes:
+        text = text.replace("package://", str(package_dir()) + "/")
+    if tool is not None:
+        if tool.parent not in FLANGE_FRAMES:
+            raise Ur3HanoiError(f"tool parent frame {tool.parent!r} is invalid: expected one of {FLANGE_FRAMES}")
+        xyz = " ".join(_fmt(v) for v in tool.xyz)
+        rpy = " ".join(_fmt(v) for v in tool.rpy)
+        tcp = (
+            '  <link name="tcp"/>\n'
+            '  <joint name="tcp_fixed_joint" type="fixed">\n'
+            f'    <parent link="{tool.parent}"/>\n    <child link="tcp"/>\n'
+            f'    <origin xyz="{xyz}" rpy="{rpy}"/>\n  </joint>\n'
+        )
+        text = re.sub(r"</robot>\s*$", tcp + "</robot>\n", text)
+    return text
+
+
+def dh_link(theta: float, i: int, dh: DHParameters | None = None) -> FloatArray:
+    """4x4 DH transform of joint ``i`` (0-based) at angle ``theta`` [rad]: Rz(theta) Tz(d) Tx(a) Rx(alpha).
+
+    Scalar form for the closed-form IK's hot path; :func:`dh_fk` builds the same matrices vectorized. ``dh``: the
+    robot's table (default the UR3's).
+    """
+    DH_D, DH_A, DH_ALPHA = _table(dh)
+    ct, st = math.cos(theta), math.sin(theta)
+    ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
+    return np.array(
+        [[ct, -st * ca, st * sa, DH_A[i] * ct], [st, ct * ca, -ct * sa, DH_A[i] * st], [0.0, sa, ca, DH_D[i]],
+         [0.0, 0.0, 0.0, 1.0]]
+    )
+
+
+def _table(dh: DHParameters | None) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+    """(d, a, alpha) of ``dh``, or the UR3's module constants."""
+    return (DH_D, DH_A, DH_ALPHA) if dh is None else (dh.d, dh.a, dh.alpha)
+
+
+def dh_fk(q: FloatArray, dh: DHParameters | None = None) -> FloatArray:
+    """UR3 (or ``dh``'s robot) forward kinematics from the DH table: the pose of the flange (``tool0``) in ``base``.
+
+    ``q`` [rad] of shape (6,) gives a 4x4 matrix; shape (N, 6) gives (N, 4, 4) (batched, for checks over whole
+    trajectories without a per-sample Pinocchio call).
+    """
+    DH_D, DH_A, DH_ALPHA = _table(dh)
+    q = np.asarray(q, dtype=float)
+    qs = q.reshape(-1, N_JOINTS)
+    T = np.broadcast_to(np.eye(4), (len(qs), 4, 4))
+    for i in range(N_JOINTS):
+        ct, st = np.cos(qs[:, i]), np.sin(qs[:, i])
+        ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
+        A = np.zeros((len(qs), 4, 4))
+        A[:, 0, 0], A[:, 0, 1], A[:, 0, 2], A[:, 0, 3] = ct, -st * ca, st * sa, DH_A[i] * ct
+        A[:, 1, 0], A[:, 1, 1], A[:, 1, 2], A[:, 1, 3] = st, ct * ca, -ct * sa, DH_A[i] * st
+        A[:, 2, 1], A[:, 2, 2], A[:, 2, 3] = sa, ca, DH_D[i]
+        A[:, 3, 3] = 1.0
+        T = T @ A
+    return T[0] if q.ndim == 1 else T
+
+
+# Link lengths the URDF must encode [m]; a UR5 (d1 = 0.089159, a2 = 0.425) fails this check.
+_EXPECTED_LENGTHS = {"d1": 0.1519, "a2": 0.24365, "a3": 0.21325, "d4": 0.11235, "d5": 0.08535, "d6": 0.0819}
+
+
+def _link_lengths(chain: UrdfChain) -> dict[str, float]:
+    def p(name: str) -> FloatArray:
+        return chain.joint_placements[chain.joint_names.index(name)][:3, 3]
+
+    return {
+        "d1": float(p("shoulder_pan_joint")[2]),
+        "a2": float(p("elbow_joint")[2]),
+        "a3": float(p("wrist_1_joint")[2]),
+        "d4": float(p("shoulder_lift_joint")[1] + p("elbow_joint")[1] + p("wrist_2_joint")[1]),
+        "d5": float(p("wrist_3_joint")[2]),
+        "d6": float(chain.frames["tool0"][1][1, 3]),
+    }
+
+
+class Ur3Model:
+    """The UR3 with an optional ``tcp`` frame: NumPy FK of its URDF chain (:mod:`ur3hanoi.robot.chain`) and the
+    Pinocchio model (built on first use of :attr:`model`, :attr:`data`, :attr:`frame_ids`, :meth:`fk`).
+
+    FK results are expressed in the controller ``base`` frame (see the module docstring).
+
+    Args:
+        tool: the suction point offset; without it the ``tcp`` frame equals ``tool0``.
+        limits: joint limits to report and enforce (datasheet values by default).
+    """
+
+    def __init__(self, tool: ToolOffset | None = None, limits: JointLimits | None = None,
+                 robot: RobotDescription = UR3) -> None:
+        self.tool = tool if tool is not None else ToolOffset(parent="tool0")
+        self.limits = limits if limits is not None else JointLimits.for_robot(robot)
+        self.description = robot
+        self.dh: DHParameters = robot.dh
+        self.urdf = urdf_text(self.tool, absolute_meshes=True, robot=robot)
+        self.chain = parse_chain(self.urdf)
+        if self.chain.joint_names != JOINT_NAMES:
+            raise Ur3HanoiError(f"URDF joints {self.chain.joint_names} are not the UR3's {JOINT_NAMES}")
+        lengths = _link_lengths(self.chain)
+        d, a = robot.dh.d, robot.dh.a
+        expected_lengths = _EXPECTED_LENGTHS if robot is UR3 else {
+            "d1": d[0], "a2": -a[1], "a3": -a[2], "d4": d[3], "d5": d[4], "d6": d[5]}
+        for key, expected in expected_lengths.items():
+            if abs(lengths[key] - expected) > 1e-6:
+                raise Ur3HanoiError(
+                    f"{robot.urdf_file or robot.name}: link length {key} = {lengths[key]} m, expected the "
+                    f"{robot.title}'s {expected} m (is this a UR5/UR10 URDF?)"
+                )
+        for name in ("base", "base_link", "tool0", "tcp", "ee_link"):
+            if name not in self.chain.frames:
+                raise Ur3HanoiError(f"{robot.urdf_file or robot.name}: the URDF has no {name!r} link")
+        # The flange seen from the TCP: constant, used by every IK solve to turn a TCP target into a flange one.
+        f = self.chain.frames
+        if f["tcp"][0] != f["tool0"][0]:
+            raise Ur3HanoiError(f"{robot.urdf_file or robot.name}: the tcp and tool0 links are not fixed to the same "
+                                "joint")
+        self.H_tcp_tool0: FloatArray = rigid_inverse(se3_act_inv(f["tool0"][1], f["tcp"][1]))
+
+    @cached_property
+    def model(self) -> pin.Model:
+        """Pinocchio's model of the URDF (with the ``tcp`` frame), built on first use."""
+        import pinocchio as pin
+
+        model = pin.buildModelFromXML(self.urdf)
+        if tuple(model.names[1:]) != JOINT_NAMES:
+            raise Ur3HanoiError(f"URDF joints {tuple(model.names[1:])} are not the UR3's {JOINT_NAMES}")
+        return model
+
+    @cached_property
+    def data(self) -> pin.Data:
+        """Pinocchio's data of :attr:`model` (one per model: :meth:`fk` is not thread-safe)."""
+        return self.model.createData()
+
+    @cached_property
+    def frame_ids(self) -> dict[str, int]:
+        """Pinocchio frame ids of ``base``, ``base_link``, ``tool0``, ``tcp`` and ``ee_link``."""
+        return {name: self.model.getFrameId(name) for name in ("base", "base_link", "tool0", "tcp", "ee_link")}
+
+    @cached_property
+    def T_tcp_tool0(self) -> pin.SE3:
+        """:attr:`H_tcp_tool0` as a ``pin.SE3``."""
+        import pinocchio as pin
+
+        return pin.SE3(self.H_tcp_tool0)
+
+    @property
+    def nq(self) -> int:
+        return N_JOINTS
+
+    def fk(self, q: FloatArray, frame: str = "tcp") -> pin.SE3:
+        """Pose of ``frame`` in the controller ``base`` frame at joint angles ``q`` [rad] (Pinocchio's FK)."""
+        import pinocchio as pin
+
+        try:
+            fid = self.frame_ids[frame]
+        except KeyError:
+            raise Ur3HanoiError(f"frame {frame!r} is unknown: expected one of {sorted(self.frame_ids)}") from None
+        pin.framesForwardKinematics(self.model, self.data, np.asarray(q, dtype=float))
+        return _se3("T_BASE_BASELINK") * self.data.oMf[fid]
+
+    def fk_matrix(self, q: FloatArray, frame: str = "tcp") -> FloatArray:
+        """4x4 pose of ``frame`` in the controller ``base`` frame at ``q`` [rad] ((N, 4, 4) for ``q`` of shape
+        (N, 6)): the NumPy FK of the URDF chain, equal to :meth:`fk` to rounding (no Pinocchio)."""
+        if frame not in ("base", "base_link", "tool0", "tcp", "ee_link"):
+            raise Ur3HanoiError(f"frame {frame!r} is unknown: expected one of "
+                                f"{sorted(('base', 'base_link', 'tool0', 'tcp', 'ee_link'))}")
+        return H_BASE_BASELINK @ self.chain.fk(q, frame)
+
+    def frame_jacobian_local(self, q: FloatArray, frame: str = "tcp") -> FloatArray:
+        """6x6 Jacobian of ``frame`` in its own (LOCAL) frame; frame-independent of the root rotation."""
+        import pinocchio as pin
+
+        return pin.computeFrameJacobian(
+            self.model, self.data, np.asarray(q, dtype=float), self.frame_ids[frame], pin.LOCAL
+        )
+
+    def H_flange_tcp(self, flange: str = "tool0") -> FloatArray:
+        """:meth:`T_flange_tcp` as a 4x4 matrix, from the URDF chain (no Pinocchio)."""
+        if flange not in FLANGE_FRAMES:
+            raise Ur3HanoiError(f"flange frame {flange!r} is invalid: expected one of {FLANGE_FRAMES}")
+        f = self.chain.frames
+        return se3_act_inv(f[flange][1], f["tcp"][1])
+
+    def T_flange_tcp(self, flange: str = "tool0") -> pin.SE3:
+        """The constant TCP pose in a flange frame (``tool0`` or ``ee_link``)."""
+        f = self.model.frames
+        return f[self.frame_ids[flange]].placement.actInv(f[self.frame_ids["tcp"]].placement)
+
+
+@cache
+def load_ur3(tool: ToolOffset | None = None, limits: JointLimits | None = None,
+             robot: RobotDescription = UR3) -> Ur3Model:
+    """Cached :class:`Ur3Model` for a tool offset (models are read-only after construction); ``robot`` picks
+    another arm of :mod:`ur3hanoi.robot.registry` (the UR3 by default).
+
+    Not thread-safe: each model owns one ``pin.Data`` used by :meth:`Ur3Model.fk`.
+    """
+    return Ur3Model(tool, limits, robot)
+
+
+__all__ = [
+    "DH_A",
+    "DH_ALPHA",
+    "DH_D",
+    "FLANGE_FRAMES",
+    "H_BASELINK_BASE",
+    "H_BASE_BASELINK",
+    "JOINT_NAMES",
+    "N_JOINTS",
+    "Q_HOME_LAB",
+    "T_BASELINK_BASE",
+    "JointLimits",
+    "ToolOffset",
+    "Ur3Model",
+    "dh_fk",
+    "dh_link",
+    "load_ur3",
+    "package_dir",
+    "urdf_path",
+    "urdf_text",
+]
