@@ -11,8 +11,8 @@ from ur3hanoi.errors import TableError
 from ur3hanoi.robot.ik import pose_errors
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
-from ur3hanoi.station.grid import T_world_tcp
-from ur3hanoi.tables.ik_table import check_table, generate_table, pose_label
+from ur3hanoi.station.grid import T_world_tcp, pose_label
+from ur3hanoi.tables.ik_table import check_table, generate_table
 
 
 def test_every_pose_reaches_its_target(shipped_station: Station) -> None:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from ur3hanoi.audit.calibration import audit_taught, check_against, default_base, report_from_fit
 from ur3hanoi.audit.fitted import audit_table
-from ur3hanoi.audit.report import STATUSES, STRICT_DEG, STRICT_MM, AuditEntry, AuditReport, AuditSuspect
+from ur3hanoi.audit.report import STATUSES, STRICT_DEG, STRICT_MM, AuditEntry, AuditReport
 
 __all__ = [
     "STATUSES",
@@ -27,7 +27,6 @@ __all__ = [
     "STRICT_MM",
     "AuditEntry",
     "AuditReport",
-    "AuditSuspect",
     "audit_table",
     "audit_taught",
     "check_against",

@@ -14,18 +14,18 @@ import math
 
 import numpy as np
 
-from ur3hanoi.audit.report import STRICT_DEG, STRICT_MM, AuditEntry, AuditReport, AuditSuspect
+from ur3hanoi.audit.report import STRICT_DEG, STRICT_MM, AuditEntry, AuditReport
 from ur3hanoi.calibrate import CalibrationFit
 from ur3hanoi.calibrate.explain import diagnose
 from ur3hanoi.calibrate.grid_fit import measure, rotation_error_deg
+from ur3hanoi.calibrate.result import Suspect
 from ur3hanoi.calibrate.robust import Thresholds
 from ur3hanoi.calibrate.taught import TaughtPoints
 from ur3hanoi.errors import TableError, printable
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
-from ur3hanoi.station.grid import ABOVE, ON, T_world_tcp
+from ur3hanoi.station.grid import ABOVE, ON, T_world_tcp, pose_label
 from ur3hanoi.tables import RecordedTable, Slot
-from ur3hanoi.tables.ik_table import pose_label
 
 
 def report_from_fit(fit: CalibrationFit, reference: str, shape: tuple[int, int] | None = None, key: str = "Q",
@@ -40,9 +40,7 @@ def report_from_fit(fit: CalibrationFit, reference: str, shape: tuple[int, int] 
         rows = [by_slot.get((t, h, k)) or AuditEntry(t, h, k, f"{key}[{t}][{h}][{k}]", math.nan, math.nan, math.nan,
                                                         "missing")
                 for t in range(shape[0]) for h in range(shape[1]) for k in (0, 1)]
-    suspects = tuple(AuditSuspect(tower=s.tower, height=s.height, k=s.k, field=s.field, error_mm=s.error_mm,
-                                  reason=s.reason) for s in fit.suspects)
-    return AuditReport(reference=reference, fitted=True, entries=tuple(rows), suspects=suspects, rms_mm=fit.rms_mm,
+    return AuditReport(reference=reference, fitted=True, entries=tuple(rows), suspects=fit.suspects, rms_mm=fit.rms_mm,
                        points_used=fit.n_used, thresholds=fit.thresholds, shared_above=shared_above,
                        problem=fit.problem)
 
@@ -82,7 +80,7 @@ def check_against(table: RecordedTable, station: Station, tol_mm: float = STRICT
                     targets, grid_points, order, station.tool_yaw, tol_mm, tol_deg, labels)
     src = printable(station.source)
     suspects = tuple(
-        AuditSuspect(tower=present[i][0], height=present[i][1], k=present[i][2], field=fields[i],
+        Suspect(tower=present[i][0], height=present[i][1], k=present[i][2], field=fields[i],
                      error_mm=float(err_mm[i]),
                      reason=f"{err_mm[i]:.1f} mm / {rot[i]:.2f} deg from the pose of {src} (tolerance {tol_mm:g} mm / "
                             f"{tol_deg:g} deg); {what[i]}")

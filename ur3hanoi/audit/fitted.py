@@ -26,7 +26,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ur3hanoi.audit.report import AuditEntry, AuditReport, AuditSuspect
+from ur3hanoi.audit.report import AuditEntry, AuditReport
 from ur3hanoi.audit.rule import (
     ABOVE_CLEAR_MM,
     CONTACT_FLAG_MM,
@@ -43,14 +43,14 @@ from ur3hanoi.audit.rule import (
 )
 from ur3hanoi.calibrate.explain import diagnose_contacts
 from ur3hanoi.calibrate.grid_fit import GridModel, Measured, measure
+from ur3hanoi.calibrate.result import Suspect
 from ur3hanoi.calibrate.robust import RobustFit, Thresholds, robust_fit
 from ur3hanoi.calibrate.taught import taught_from_recorded
 from ur3hanoi.errors import TaughtPointsError, printable
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
-from ur3hanoi.station.grid import ABOVE, ON
+from ur3hanoi.station.grid import ABOVE, ON, pose_label
 from ur3hanoi.tables import RecordedTable, Slot
-from ur3hanoi.tables.ik_table import pose_label
 
 
 def _grid_like(base: Station, n_towers: int, n_heights: int) -> Station:
@@ -204,10 +204,10 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
                                                        math.nan, "missing")
                  for t in range(n_t) for h in range(n_h) for k in (ON, ABOVE))
 
-    def listed(status: str) -> tuple[AuditSuspect, ...]:
+    def listed(status: str) -> tuple[Suspect, ...]:
         chosen = sorted((e for e in rows if e.status == status),
                         key=lambda e: -verdicts[(e.tower, e.height, e.k)].severity)
-        return tuple(AuditSuspect(tower=e.tower, height=e.height, k=e.k, field=e.field, error_mm=e.error_mm,
+        return tuple(Suspect(tower=e.tower, height=e.height, k=e.k, field=e.field, error_mm=e.error_mm,
                                   reason=e.reason) for e in chosen)
 
     notes, problem = _notes_and_problem(base, layout, sol.step, step_fitted, axis, rows, rule, len(c_idx),

@@ -15,9 +15,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from ur3hanoi.audit.rule import AuditRule
+from ur3hanoi.calibrate.result import Suspect
 from ur3hanoi.calibrate.robust import Thresholds
-from ur3hanoi.station.grid import POSE_NAMES
-from ur3hanoi.tables.ik_table import pose_label
+from ur3hanoi.station.grid import POSE_NAMES, pose_label
 
 STRICT_MM = 1.0
 """[mm] default position tolerance against a calibration (generated tables)."""
@@ -83,22 +83,6 @@ class AuditEntry:
 
 
 @dataclass(frozen=True)
-class AuditSuspect:
-    """A suspect entry: ``error_mm`` from the reference [mm] and ``reason`` (towers and heights from 1)."""
-
-    tower: int
-    height: int
-    k: int
-    field: str
-    error_mm: float
-    reason: str
-
-    @property
-    def label(self) -> str:
-        return pose_label(self.tower, self.height, self.k)
-
-
-@dataclass(frozen=True)
 class AuditReport:
     """The audit of one table or set of taught points.
 
@@ -122,14 +106,14 @@ class AuditReport:
     reference: str
     fitted: bool
     entries: tuple[AuditEntry, ...]
-    suspects: tuple[AuditSuspect, ...]
+    suspects: tuple[Suspect, ...]
     rms_mm: float
     points_used: int
     thresholds: Thresholds
     shared_above: tuple[tuple[int, tuple[int, ...]], ...] = ()
     problem: str = ""
     rule: AuditRule | None = None
-    warnings: tuple[AuditSuspect, ...] = ()
+    warnings: tuple[Suspect, ...] = ()
     notes: tuple[str, ...] = ()
     layout: str = ""
 
@@ -144,7 +128,7 @@ class AuditReport:
 
     def to_json(self) -> dict[str, Any]:
         """The ``--json`` object: ``{"entries": [...], "suspects": [...], "fit": {...}}``, numbered from 1."""
-        def listed(items: tuple[AuditSuspect, ...]) -> list[dict[str, Any]]:
+        def listed(items: tuple[Suspect, ...]) -> list[dict[str, Any]]:
             return [{"tower": s.tower + 1, "height": s.height + 1, "pose": POSE_NAMES[s.k], "field": s.field,
                      "error_mm": _num(s.error_mm), "reason": s.reason} for s in items]
 
@@ -247,5 +231,4 @@ __all__ = [
     "STRICT_MM",
     "AuditEntry",
     "AuditReport",
-    "AuditSuspect",
 ]

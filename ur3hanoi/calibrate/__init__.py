@@ -11,7 +11,7 @@ point::
     ur3hanoi calibrate --from-table lab2_data.yaml --key real_pos --base lab_real -o out.yaml
 
 The same robust fit, on a table's contacts alone, audits a table on its own (``ur3hanoi check-table --fit``,
-:mod:`ur3hanoi.audit.fitted`), judging every entry by the rule of :mod:`~ur3hanoi.audit.rule`.
+:mod:`ur3hanoi.audit.fitted`), judging every entry by the audit's rule (:mod:`ur3hanoi.audit.rule`).
 
 Module map:
 
@@ -21,9 +21,8 @@ Module map:
   from the data's robust scatter (``max(3 mm, 5 sigma)``, ``max(2 deg, 5 sigma)``).
 - :mod:`~ur3hanoi.calibrate.explain`: why a pose is off (a typo in one joint, swapped or copied entries, a pose
   recorded in the wrong slot); :func:`~ur3hanoi.calibrate.explain.diagnose_contacts` with the heading left free.
-- :mod:`~ur3hanoi.audit.rule`: the audit rule in mm and deg (contacts: never flagged within 5 mm / 4 deg,
-  always over 8 mm / 5 deg; above poses clear of the top level and on their contact's line).
-- :mod:`~ur3hanoi.calibrate.fit`: :func:`fit_station`, the :class:`CalibrationFit` result and its suspects.
+- :mod:`~ur3hanoi.calibrate.fit`: :func:`fit_station`, the fit and the judgement of every point.
+- :mod:`~ur3hanoi.calibrate.result`: its result, :class:`CalibrationFit`, and :class:`Suspect` (also the audit's).
 - :mod:`~ur3hanoi.calibrate.output`: the calibration file written (refused when the fit is not sound).
 
 What is fitted: one origin ``o_t`` per tower (explicit ``tower_origins``: real towers are rarely evenly spaced),
@@ -38,8 +37,9 @@ The taught-points file and its checks are :mod:`ur3hanoi.calibrate.taught`.
 from __future__ import annotations
 
 from ur3hanoi.calibrate.explain import JOINT_LABELS, JointTypo, joint_typo
-from ur3hanoi.calibrate.fit import MAX_TILT_DEG, CalibrationFit, ResidualRow, Suspect, fit_station
+from ur3hanoi.calibrate.fit import MAX_TILT_DEG, fit_station
 from ur3hanoi.calibrate.output import calibration_text, write_calibration
+from ur3hanoi.calibrate.result import CalibrationFit, ResidualRow, Suspect
 from ur3hanoi.calibrate.robust import (
     MIN_SUSPECT_DEG,
     MIN_SUSPECT_MM,

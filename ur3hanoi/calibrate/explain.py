@@ -203,7 +203,7 @@ def diagnose(robot: Ur3Model, T_world_base: pin.SE3, slots: Sequence[Slot], qs: 
         yaw: the grid's tool yaw [rad]; tol_mm, tol_deg: the thresholds.
         labels: how each point is named (``"tower 1 height 2 on (real_pos[0][1][0])"``).
     """
-    from ur3hanoi.tables.ik_table import pose_label
+    from ur3hanoi.station.grid import pose_label
 
     dup = duplicates(slots, qs, [False] * len(slots))
     swaps = find_swaps(slots, p_world, grid_points, suspects, tol_mm)
@@ -290,7 +290,7 @@ def diagnose_contacts(robot: Ur3Model, T_world_base: pin.SE3, slots: Sequence[Sl
             ones.
         labels: how each contact is named.
     """
-    from ur3hanoi.tables.ik_table import pose_label
+    from ur3hanoi.station.grid import pose_label
 
     dup = duplicates(slots, qs, [False] * len(slots))
     swaps = find_swaps(slots, p_world, grid_points, suspects, flag_mm)

@@ -36,15 +36,15 @@ from ur3hanoi.calibrate.grid_fit import (
     choose_model,
     measure,
 )
-from ur3hanoi.calibrate.robust import RobustFit, Thresholds, robust_fit
+from ur3hanoi.calibrate.result import CalibrationFit, Suspect
+from ur3hanoi.calibrate.robust import RobustFit, robust_fit
 from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
 from ur3hanoi.errors import CalibrationError, TaughtPointsError, printable
 from ur3hanoi.robot.ik import wrap_angle
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
-from ur3hanoi.station.grid import ABOVE, ON, POSE_NAMES
+from ur3hanoi.station.grid import ABOVE, ON
 from ur3hanoi.tables import Slot
-from ur3hanoi.tables.ik_table import pose_label
 
 MAX_TILT_DEG = 10.0  # [deg] a taught pose's tool must point down within this to be used (tables use exactly down)
 MAX_APPROACH_M = 0.5  # [m] largest approach height a fit may give
@@ -52,130 +52,6 @@ MAX_APPROACH_M = 0.5  # [m] largest approach height a fit may give
 
 def _fail(source: str, msg: str) -> TaughtPointsError:
     return TaughtPointsError(f"{printable(source)}: {msg}", source=source)
-
-
-@dataclass(frozen=True)
-class Suspect:
-    """A point that disagrees with the fitted grid.
-
-    Attributes:
-        index: the point's position in :attr:`CalibrationFit.points`.
-        tower, height, k: its slot, 0-based indices.
-        field: where it is in its file (``points[3]``, ``real_pos[1][2][0]``).
-        error_mm: its distance from the grid [mm] (the grid fitted without it); NaN when it has no grid slot.
-        severity: ``max(error / threshold_mm, orientation error / threshold_deg)``; suspects sort by it.
-        reason: why it is suspect and what probably happened, for people (towers and heights from 1).
-    """
-
-    index: int
-    tower: int
-    height: int
-    k: int
-    field: str
-    error_mm: float
-    severity: float
-    reason: str
-
-    @property
-    def label(self) -> str:
-        return pose_label(self.tower, self.height, self.k)
-
-
-@dataclass(frozen=True)
-class ResidualRow:
-    """One row of the residual report (one taught point). Lengths [mm], angles [deg]; ``tower``, ``height``
-    0-based indices."""
-
-    index: int
-    tower: int
-    height: int
-    pose: str
-    residual_mm: float
-    dx_mm: float
-    dy_mm: float
-    dz_mm: float
-    yaw_dev_deg: float
-    tilt_deg: float
-    flagged: bool
-    field: str = ""
-    status: str = "ok"
-
-
-@dataclass(frozen=True)
-class CalibrationFit:
-    """Result of :func:`fit_station`; everything a report or a notebook needs.
-
-    Attributes:
-        station: the fitted station (base calibration with the new grid and tool yaw).
-        points: the taught points, in input order.
-        measured: FK suction points, shape (N, 3) [m, world].
-        fitted: the fitted grid's suction points for the same slots, shape (N, 3) [m, world] (NaN rows for a
-            slot outside the grid; for a shared above pose, the nearest point over its tower).
-        residuals_mm: ``|measured - fitted|`` per point [mm], shape (N,).
-        yaw_dev_deg: each point's TCP heading minus the fitted tool yaw [deg], shape (N,).
-        tilt_deg: each point's tool tilt from pointing straight down [deg], shape (N,).
-        rot_deg: each point's orientation error from the grid pose [deg], shape (N,).
-        fitted_params: which grid parameters the points determined (others come from the base calibration).
-        dof: redundancy of the position fit (3 x points used minus the unknowns); 0 = exact fit.
-        used: shape (N,), the points the final fit used.
-        status: per point, ``"ok"`` or ``"suspect"``.
-        suspects: the suspect points, worst first.
-        thresholds: the suspect thresholds.
-        missing: the slots a table left empty ``(tower, height, k)`` (0-based).
-        problem: why the fit is not sound ("" when it is).
-        warnings: one line per suspect (``"<label>: <reason>"``) and the problem, if any.
-    """
-
-    station: Station
-    points: tuple[TaughtPoint, ...]
-    measured: FloatArray
-    fitted: FloatArray
-    residuals_mm: FloatArray
-    yaw_dev_deg: FloatArray
-    tilt_deg: FloatArray
-    rot_deg: FloatArray
-    fitted_params: tuple[str, ...]
-    dof: int
-    used: tuple[bool, ...]
-    status: tuple[str, ...]
-    suspects: tuple[Suspect, ...]
-    thresholds: Thresholds
-    missing: tuple[Slot, ...]
-    problem: str
-    warnings: tuple[str, ...]
-
-    @property
-    def sound(self) -> bool:
-        """True when the fit can be trusted to write a station (see the module docstring)."""
-        return not self.problem
-
-    @property
-    def n_used(self) -> int:
-        return int(sum(self.used))
-
-    @property
-    def rms_mm(self) -> float:
-        """Root mean square of the residuals of the points used [mm]."""
-        used = np.array(self.used)
-        return float(np.sqrt(np.mean(self.residuals_mm[used] ** 2))) if used.any() else math.nan
-
-    @property
-    def max_mm(self) -> float:
-        """Largest residual of the points used [mm]."""
-        used = np.array(self.used)
-        return float(np.max(self.residuals_mm[used])) if used.any() else math.nan
-
-    def residual_table(self) -> list[ResidualRow]:
-        """Per-point rows (``pandas.DataFrame(fit.residual_table())`` works)."""
-        d = (self.measured - self.fitted) * 1e3
-        return [
-            ResidualRow(index=p.index, tower=p.tower, height=p.height, pose=POSE_NAMES[p.k],
-                        residual_mm=float(self.residuals_mm[i]), dx_mm=float(d[i, 0]), dy_mm=float(d[i, 1]),
-                        dz_mm=float(d[i, 2]), yaw_dev_deg=float(self.yaw_dev_deg[i]),
-                        tilt_deg=float(self.tilt_deg[i]), flagged=self.status[i] == "suspect", field=p.where,
-                        status=self.status[i])
-            for i, p in enumerate(self.points)
-        ]
 
 
 # --------------------------------------------------------------------------------------------------- checks
@@ -431,4 +307,4 @@ def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray) -> str
     return ""
 
 
-__all__ = ["MAX_TILT_DEG", "CalibrationFit", "ResidualRow", "Suspect", "fit_station"]
+__all__ = ["MAX_TILT_DEG", "fit_station"]

@@ -9,7 +9,7 @@ import numpy as np
 import yaml
 
 from ur3hanoi import __version__
-from ur3hanoi.calibrate.fit import CalibrationFit
+from ur3hanoi.calibrate.result import CalibrationFit
 from ur3hanoi.calibrate.taught import TaughtPoints
 from ur3hanoi.errors import CalibrationError, TaughtPointsError, printable
 from ur3hanoi.io.atomic import atomic_write

@@ -35,9 +35,8 @@ from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
 from ur3hanoi.robot.model import N_JOINTS
 from ur3hanoi.station.calibration import MAX_HEIGHTS, MAX_TOWERS
-from ur3hanoi.station.grid import ABOVE, ON, POSE_NAMES
+from ur3hanoi.station.grid import ABOVE, ON, POSE_NAMES, pose_label
 from ur3hanoi.tables import RecordedTable, Slot, read_recorded_table
-from ur3hanoi.tables.ik_table import pose_label
 
 UNITS: tuple[str, ...] = ("deg", "rad")
 MAX_TAUGHT_POINTS = 1000

@@ -22,6 +22,12 @@ ON, ABOVE = 0, 1
 POSE_NAMES: tuple[str, str] = ("on", "above")
 
 
+def pose_label(tower: int, height: int, k: int) -> str:
+    """How people name ``Q[tower][height][k]`` (0-based indices): ``pose_label(0, 1, 1) == "tower 1 height 2
+    above"``. Towers and heights are numbered from 1 wherever a person reads them."""
+    return f"tower {tower + 1} height {height + 1} {POSE_NAMES[k]}"
+
+
 def R_world_tcp_down(yaw: float) -> FloatArray:
     """TCP orientation with z pointing straight down and x along ``(cos yaw, sin yaw, 0)`` in world."""
     c, s = math.cos(yaw), math.sin(yaw)

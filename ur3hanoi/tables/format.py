@@ -41,7 +41,7 @@ def _vec(values: Sequence[float]) -> str:
 def format_q(q: Any, key: str) -> str:
     """Block-YAML text of ``key: Q[tower][height][k]`` (``q``: nested sequences or an array, shape (T, H, 2, 6)
     [rad]) with one commented 6-vector per line."""
-    from ur3hanoi.tables.ik_table import pose_label
+    from ur3hanoi.station.grid import pose_label
 
     lines = [f"{key}:"]
     for t, tower in enumerate(q):

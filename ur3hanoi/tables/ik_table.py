@@ -19,7 +19,7 @@ from ur3hanoi.robot.chain import se3_act_inv
 from ur3hanoi.robot.ik import IKResult, IKSolver, branch_of, make_solver, pose_errors, solve_table_on_branch
 from ur3hanoi.robot.model import N_JOINTS, load_ur3
 from ur3hanoi.station.calibration import Station
-from ur3hanoi.station.grid import POSE_NAMES, H_world_tcp, T_world_tcp
+from ur3hanoi.station.grid import H_world_tcp, T_world_tcp, pose_label
 
 
 @dataclass(frozen=True)
@@ -40,12 +40,6 @@ class Table:
     def max_orientation_error(self) -> float:
         """Largest IK orientation error over the table [rad]."""
         return max(r.orientation_error for r in self.results)
-
-
-def pose_label(tower: int, height: int, k: int) -> str:
-    """How people name ``Q[tower][height][k]`` (0-based indices): ``pose_label(0, 1, 1) == "tower 1 height 2
-    above"``. Towers and heights are numbered from 1 wherever a person reads them."""
-    return f"tower {tower + 1} height {height + 1} {POSE_NAMES[k]}"
 
 
 def generate_table(station: Station, solver: str | IKSolver = "pinocchio") -> Table:
@@ -107,4 +101,4 @@ def check_table(q: FloatArray, station: Station, tol_mm: float = 1.0, tol_deg: f
     return rows
 
 
-__all__ = ["CheckRow", "Table", "check_table", "generate_table", "pose_label"]
+__all__ = ["CheckRow", "Table", "check_table", "generate_table"]

@@ -22,8 +22,8 @@ from ur3hanoi.io.schema import Field, ListOf, Nullable, Number, Record, Spec, Ve
 from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.robot.model import N_JOINTS
 from ur3hanoi.station.calibration import MAX_HEIGHTS, MAX_TOWERS
+from ur3hanoi.station.grid import pose_label
 from ur3hanoi.tables.file import BLOCK_XY_KEY, TABLE_KEYS, WHAT, LabFile, check_key, read_lab_file
-from ur3hanoi.tables.ik_table import pose_label
 from ur3hanoi.tables.visits import require_entries
 
 JOINT_ANGLE = Number(-2 * math.pi, 2 * math.pi, unit="rad", what="a joint angle")
