@@ -22,7 +22,7 @@ not fit one grid, has :attr:`~ur3hanoi.audit.report.AuditReport.problem` set (ex
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -80,6 +80,35 @@ def _layout_note(base: Station, layout: str, step: np.ndarray, fitted: bool) -> 
     return note
 
 
+@dataclass(frozen=True)
+class _Fitted:
+    """A table's entries measured by FK and its grid fitted robustly to the contacts (step 1-4 of the module
+    docstring): what judging the entries reads. Indices ``i`` run over ``slots`` (the entries present), ``j`` over
+    the contacts used (``c_idx``)."""
+
+    table: RecordedTable
+    base: Station
+    slots: list[Slot]
+    qs: np.ndarray  # (N, 6) [rad]
+    m: Measured  # every entry present
+    mc: Measured  # the contacts within the joint limits
+    in_limits: np.ndarray  # (N,) bool
+    c_idx: np.ndarray  # (C,) indices of the contacts in slots
+    c_slots: list[Slot]
+    tilt: np.ndarray  # (N,) [deg] from the table's axis
+    axis: np.ndarray  # the table's own suction axis [world]
+    fit: RobustFit
+    layout: str
+    step_fitted: bool
+    checkable: np.ndarray  # (C,) bool
+    rule: AuditRule
+    field: dict[Slot, str]
+
+    @property
+    def limits_why(self) -> str:
+        return f"its joint angles are outside the joint limits of {printable(self.base.source)}: left out of the fit"
+
+
 def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None, tol_deg: float | None = None
                 ) -> AuditReport:
     """Audit ``table`` on its own by the rule of :mod:`ur3hanoi.audit.rule` (see the module docstring).
@@ -93,6 +122,22 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
         TaughtPointsError: some tower has no usable contact pose (the message says which, and what is needed), or
             the values are not radians.
     """
+    ctx = _fit_contacts(table, base, tol_mm, tol_deg)
+    entries: dict[Slot, AuditEntry] = {}
+    verdicts: dict[Slot, Verdict] = {}
+    _judge_contacts(ctx, entries, verdicts)
+    _judge_the_rest(ctx, entries, verdicts)
+    reasons = _contact_reasons(table, base, ctx.slots, ctx.qs, ctx.m.p_world, ctx.tilt, ctx.axis, ctx.c_idx, ctx.fit,
+                               verdicts, entries, ctx.rule, ctx.field)
+    for s, why in reasons.items():
+        entries[s] = replace(entries[s], status="suspect" if verdicts[s].status == "flagged" else verdicts[s].status,
+                             reason=why)
+    _on_above_swaps(entries, ctx.rule)
+    return _report(ctx, entries, verdicts)
+
+
+def _fit_contacts(table: RecordedTable, base: Station, tol_mm: float | None, tol_deg: float | None) -> _Fitted:
+    """Steps 1-4 of the module docstring: measure, fit the grid to the contacts, read the layout and the axis."""
     taught_from_recorded(table)  # the values must look like radians
     n_t, n_h = table.n_towers, table.n_heights
     grid = _grid_like(base, n_t, n_h)
@@ -127,25 +172,26 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
     layout = (("flat" if math.hypot(sol.step[0], sol.step[1]) > abs(sol.step[2]) else "stacked") if step_fitted
               else base.layout)
     checkable = fit.removable | ~fit.used
-    dev = fit.deviation
-    rule = derive_rule(np.linalg.norm(dev[checkable], axis=1) * 1e3, tilt[c_idx], tol_mm, tol_deg)
+    rule = derive_rule(np.linalg.norm(fit.deviation[checkable], axis=1) * 1e3, tilt[c_idx], tol_mm, tol_deg)
+    return _Fitted(table=table, base=base, slots=slots, qs=qs, m=m, mc=mc, in_limits=in_limits, c_idx=c_idx,
+                   c_slots=c_slots, tilt=tilt, axis=axis, fit=fit, layout=layout, step_fitted=step_fitted,
+                   checkable=checkable, rule=rule,
+                   field={s: f"{table.key}[{s[0]}][{s[1]}][{s[2]}]" for s in slots})
 
-    entries: dict[Slot, AuditEntry] = {}
-    verdicts: dict[Slot, Verdict] = {}
-    top_z = max(float(sol.point((t, h, ON))[2]) for t in range(n_t) for h in range(n_h))  # the top of any stack
-    field = {s: f"{table.key}[{s[0]}][{s[1]}][{s[2]}]" for s in slots}
-    limits_why = (f"its joint angles are outside the joint limits of {printable(base.source)}: left out of the fit")
 
-    for j, i in enumerate(c_idx):
-        s = slots[i]
+def _judge_contacts(ctx: _Fitted, entries: dict[Slot, AuditEntry], verdicts: dict[Slot, Verdict]) -> None:
+    """Judge every contact the fit used by its deviation from the grid fitted to the others (step 5)."""
+    dev, m, qs, tilt, field = ctx.fit.deviation, ctx.m, ctx.qs, ctx.tilt, ctx.field
+    for j, i in enumerate(ctx.c_idx):
+        s = ctx.slots[i]
         d = dev[j] * 1e3
-        if checkable[j]:
-            v = judge_contact(math.hypot(d[0], d[1]), float(d[2]), float(tilt[i]), rule)
+        if ctx.checkable[j]:
+            v = judge_contact(math.hypot(d[0], d[1]), float(d[2]), float(tilt[i]), ctx.rule)
         else:
-            v = judge_contact(0.0, 0.0, float(tilt[i]), rule)
+            v = judge_contact(0.0, 0.0, float(tilt[i]), ctx.rule)
             if v.status == "ok":
                 alone = (f"the only contact of tower {s[0] + 1}: nothing else fixes its line"
-                         if sum(c[0] == s[0] for c in c_slots) == 1 else
+                         if sum(c[0] == s[0] for c in ctx.c_slots) == 1 else
                          f"the grid cannot be fitted without it (with the contacts kept, it alone fixes tower "
                          f"{s[0] + 1}'s line or the step between levels)")
                 v = Verdict("unchecked", 0.0, f"{alone}, so its position cannot be checked (record another height "
@@ -156,28 +202,34 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
             error_mm=float(np.linalg.norm(d)), rot_deg=math.nan, tilt_deg=float(tilt[i]),
             status="suspect" if v.status == "flagged" else v.status, reason=v.why, q=tuple(float(x) for x in qs[i]),
             point_m=_xyz(m.p_world[i]), fitted_m=_xyz(m.p_world[i] - dev[j]),
-            off_line_mm=math.hypot(d[0], d[1]) if checkable[j] else math.nan,
-            off_level_mm=float(d[2]) if checkable[j] else math.nan)
+            off_line_mm=math.hypot(d[0], d[1]) if ctx.checkable[j] else math.nan,
+            off_level_mm=float(d[2]) if ctx.checkable[j] else math.nan)
 
-    for i, s in enumerate(slots):
+
+def _judge_the_rest(ctx: _Fitted, entries: dict[Slot, AuditEntry], verdicts: dict[Slot, Verdict]) -> None:
+    """Judge the contacts outside the joint limits and every above pose against the fitted grid (step 5)."""
+    table, sol, qs, tilt, field = ctx.table, ctx.fit.solution, ctx.qs, ctx.tilt, ctx.field
+    top_z = max(float(sol.point((t, h, ON))[2]) for t in range(table.n_towers)
+                for h in range(table.n_heights))  # the top of any stack
+    for i, s in enumerate(ctx.slots):
         if s in entries:
             continue
         c = sol.point((s[0], s[1], ON))
-        p = m.p_world[i]
+        p = ctx.m.p_world[i]
         if s[2] == ON:  # outside the joint limits
-            v = Verdict("flagged", math.inf, limits_why)
             d = (p - c) * 1e3
             entries[s] = AuditEntry(
                 tower=s[0], height=s[1], k=s[2], field=field[s], error_mm=float(np.linalg.norm(d)), rot_deg=math.nan,
                 tilt_deg=float(tilt[i]), status="suspect", q=tuple(float(x) for x in qs[i]), point_m=_xyz(p),
-                fitted_m=_xyz(c), off_line_mm=math.hypot(d[0], d[1]), off_level_mm=float(d[2]), reason=limits_why)
-            verdicts[s] = v
+                fitted_m=_xyz(c), off_line_mm=math.hypot(d[0], d[1]), off_level_mm=float(d[2]),
+                reason=ctx.limits_why)
+            verdicts[s] = Verdict("flagged", math.inf, ctx.limits_why)
             continue
         off_line = math.hypot(float(p[0] - c[0]), float(p[1] - c[1])) * 1e3
         over_top, over_contact = (float(p[2]) - top_z) * 1e3, float(p[2] - c[2]) * 1e3
         v = judge_above(off_line, over_top, over_contact)
-        if not in_limits[i]:
-            v = Verdict("flagged", math.inf, "; ".join(x for x in (v.why, limits_why) if x))
+        if not ctx.in_limits[i]:
+            v = Verdict("flagged", math.inf, "; ".join(x for x in (v.why, ctx.limits_why) if x))
         if v.status == "flagged" and table.present[s[0], s[1], ON] and np.array_equal(qs[i], table.q[s[0], s[1], ON]):
             v = replace(v, why=f"{v.why}; it holds the joint values of {pose_label(s[0], s[1], ON)}: a copied entry")
         shared = table.shared_with(s[0], s[1])
@@ -193,36 +245,34 @@ def audit_table(table: RecordedTable, base: Station, tol_mm: float | None = None
             q=tuple(float(x) for x in qs[i]), point_m=_xyz(p), fitted_m=_xyz(target), off_line_mm=off_line,
             over_top_mm=over_top, over_contact_mm=over_contact, reason=v.why)
 
-    reasons = _contact_reasons(table, base, slots, qs, m.p_world, tilt, axis, c_idx, fit, verdicts, entries, rule,
-                               field)
-    for s, why in reasons.items():
-        entries[s] = replace(entries[s], status="suspect" if verdicts[s].status == "flagged" else verdicts[s].status,
-                             reason=why)
-    _on_above_swaps(entries, rule)
 
+def _report(ctx: _Fitted, entries: dict[Slot, AuditEntry], verdicts: dict[Slot, Verdict]) -> AuditReport:
+    """Every slot in ``Q`` order (missing ones included), suspects and warnings worst first, notes and problem."""
+    table, base, fit, rule = ctx.table, ctx.base, ctx.fit, ctx.rule
     rows = tuple(entries.get((t, h, k)) or AuditEntry(t, h, k, f"{table.key}[{t}][{h}][{k}]", math.nan, math.nan,
                                                        math.nan, "missing")
-                 for t in range(n_t) for h in range(n_h) for k in (ON, ABOVE))
+                 for t in range(table.n_towers) for h in range(table.n_heights) for k in (ON, ABOVE))
 
     def listed(status: str) -> tuple[Suspect, ...]:
         chosen = sorted((e for e in rows if e.status == status),
                         key=lambda e: -verdicts[(e.tower, e.height, e.k)].severity)
         return tuple(Suspect(tower=e.tower, height=e.height, k=e.k, field=e.field, error_mm=e.error_mm,
-                                  reason=e.reason) for e in chosen)
+                             reason=e.reason) for e in chosen)
 
-    notes, problem = _notes_and_problem(base, layout, sol.step, step_fitted, axis, rows, rule, len(c_idx),
-                                        int(checkable.sum()), sol.origins)
+    sol = fit.solution
+    notes, problem = _notes_and_problem(base, ctx.layout, sol.step, ctx.step_fitted, ctx.axis, rows, rule,
+                                        len(ctx.c_idx), int(ctx.checkable.sum()), sol.origins)
     used = np.flatnonzero(fit.used)
-    resid = (mc.p_world[used] - sol.points([c_slots[j] for j in used])) * 1e3
+    resid = (ctx.mc.p_world[used] - sol.points([ctx.c_slots[j] for j in used])) * 1e3
     rms = float(np.sqrt(np.mean(np.sum(resid**2, axis=1)))) if len(used) else math.nan
-    reference = (f"grid fitted to {len(used)} of the table's {len(c_idx)} contacts by robust least squares (robot "
+    reference = (f"grid fitted to {len(used)} of the table's {len(ctx.c_idx)} contacts by robust least squares (robot "
                  f"base, tool and home of {printable(base.source)}); above poses judged against it")
     return AuditReport(reference=reference, fitted=True, entries=rows, suspects=listed("suspect"), rms_mm=rms,
                        points_used=len(used),
                        thresholds=Thresholds(mm=rule.flag_mm, deg=rule.flag_deg, sigma_mm=rule.sigma_mm,
                                              sigma_deg=rule.sigma_deg, derived=not rule.fixed),
                        shared_above=table.shared_above, problem=problem, rule=rule, warnings=listed("warn"),
-                       notes=tuple(notes), layout=layout)
+                       notes=tuple(notes), layout=ctx.layout)
 
 
 def _contact_reasons(table: RecordedTable, base: Station, slots: list[Slot], qs: np.ndarray, p_world: np.ndarray,
