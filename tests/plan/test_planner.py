@@ -21,7 +21,7 @@ from ur3hanoi.errors import IKError, PlanError, PuzzleError
 from ur3hanoi.io.resources import stations_dir
 from ur3hanoi.plan import Phase, Plan, PlanConfig, build_waypoints, check_collisions, check_vertical, plan_solve
 from ur3hanoi.plan.baseline.lab_program import lab_program_times
-from ur3hanoi.plan.motion.legs import DENSE_MARGIN_M
+from ur3hanoi.plan.motion.corridor import DENSE_MARGIN_M
 from ur3hanoi.station.calibration import Station, load_station
 from ur3hanoi.station.grid import ABOVE, ON
 

@@ -9,7 +9,7 @@ import pytest
 
 from ur3hanoi.plan import Phase, PlanConfig, build_waypoints, check_vertical, plan_solve, tcp_positions_world
 from ur3hanoi.plan.motion.blend import lateral_direction
-from ur3hanoi.plan.motion.legs import DENSE_MARGIN_M
+from ur3hanoi.plan.motion.corridor import DENSE_MARGIN_M
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import contact_point_world

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from ur3hanoi.plan import PlanConfig, build_waypoints, tcp_positions_world
-from ur3hanoi.plan.motion.legs import CONTACT_OVERSHOOT_M, Leg, SlotLegs
+from ur3hanoi.plan.motion.corridor import CONTACT_OVERSHOOT_M, Leg
+from ur3hanoi.plan.motion.legs import SlotLegs
 from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 from ur3hanoi.plan.route.connections import station_planner
 from ur3hanoi.plan.types import DEFAULT_VIA_ACCELS, DEFAULT_VIA_SPEEDS, KinematicLimits
@@ -72,7 +73,7 @@ def test_a_single_joint_segment_leaves_the_line(lab_real: Station) -> None:
     legs, _ = _slot_legs(lab_real, (2, 1))
     single = legs.ruckig.solve(*legs.above_state(legs.rest_cell, True), *legs.on).trajectory
     assert single is not None
-    dev, _, _ = legs.corridor([single])
+    dev, _, _ = legs.corridor.measure([single])
     assert dev > 0.004
 
 

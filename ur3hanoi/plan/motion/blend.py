@@ -23,7 +23,8 @@ import numpy as np
 from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.plan.motion.legs import CONTACT_OVERSHOOT_M, DENSE_MARGIN_M, Leg, SlotLegs, State, within_limits
+from ur3hanoi.plan.motion.corridor import CONTACT_OVERSHOOT_M, DENSE_MARGIN_M, Leg, State, within_limits
+from ur3hanoi.plan.motion.legs import SlotLegs
 from ur3hanoi.plan.motion.minimize import nelder_mead
 from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 from ur3hanoi.plan.types import KinematicLimits
@@ -102,8 +103,8 @@ class Blender:
             top = trial((lam * x[0], lam * x[1]))[1]
             if top is None:
                 return None
-            dev, dip, near = legs.corridor([top])
-            ok = dev <= self.tol_m - DENSE_MARGIN_M and dip <= CONTACT_OVERSHOOT_M and legs.near_ok(near)
+            dev, dip, near = legs.corridor.measure([top])
+            ok = dev <= self.tol_m - DENSE_MARGIN_M and dip <= CONTACT_OVERSHOOT_M and legs.corridor.near_ok(near)
             return dev if ok else None
 
         dev = fits(1.0)

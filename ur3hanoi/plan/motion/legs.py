@@ -22,16 +22,16 @@ Method, and why (measured on lab_sim/lab_real, see ``bench/REPORT.md``):
   limit is a structural ceiling. TOPP-RA (velocity and acceleration only) followed by a jerk-limited pass was the
   other candidate; the interior-point legs already reach the joint-space time, so no new dependency was needed.
 - Near a singularity (a slot close to the base) the joint path curves so much at the contact end that one or two
-  points dip into the block: such slots (:attr:`SlotLegs.hard`) use many points (:data:`PROFILE_POINTS`, spaced
-  toward the contact) whose states come from the exact path timing; each segment is then at least as fast as that
-  timing between its points, and the leg keeps the line. The exact path-following leg remains the last resort of
-  the rest-to-rest cell, which therefore always has legs.
-- Every leg is verified where it is built, once per (slot, via cell, direction): the suction point by forward
-  kinematics every millisecond (:data:`DENSE_RATE_HZ`), within ``tol_m`` of the line (less
-  :data:`DENSE_MARGIN_M` for the samples in between) and never more than :data:`CONTACT_OVERSHOOT_M` below the
-  contact pose (Ruckig's time-synchronised joints can settle a fraction of a millimetre past it; pressing a carried
-  block into the stack below tilts the stack, so only 0.2 mm is allowed). Legs are shared by
-  every connection that uses the cell, so a plan checks each distinct leg once.
+  points dip into the block: such slots (:attr:`SlotLegs.hard`) use many points
+  (:data:`~ur3hanoi.plan.motion.path_legs.PROFILE_POINTS`, spaced toward the contact) whose states come from the exact
+  path timing; each segment is then at least as fast as that timing between its points, and the leg keeps the line. The
+  exact path-following leg remains the last resort of the rest-to-rest cell, which therefore always has legs.
+- Every leg is verified where it is built, once per (slot, via cell, direction), against the slot's
+  :class:`~ur3hanoi.plan.motion.corridor.Corridor`: the suction point by forward kinematics every millisecond,
+  within ``tol_m`` of the line and never more than :data:`~ur3hanoi.plan.motion.corridor.CONTACT_OVERSHOOT_M`
+  below the contact pose (Ruckig's time-synchronised joints can settle a fraction of a millimetre past it; pressing
+  a carried block into the stack below tilts the stack, so only 0.2 mm is allowed). Legs are shared by every
+  connection that uses the cell, so a plan checks each distinct leg once.
 
 Descend and lift are time reverses of each other (same duration by the symmetry of the limits); each is solved
 and verified on its own. Every result is a pure function of (slot, cell): the cells of a slot can be built in any
@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 from ruckig import Trajectory as RuckigTrajectory
@@ -50,27 +49,25 @@ from ruckig import Trajectory as RuckigTrajectory
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
 from ur3hanoi.plan.kinematics import tcp_positions_world
+from ur3hanoi.plan.motion.corridor import (
+    CONTACT_OVERSHOOT_M,
+    DENSE_MARGIN_M,
+    Cell,
+    Corridor,
+    Leg,
+    State,
+    within_limits,
+)
 from ur3hanoi.plan.motion.minimize import nelder_mead
+from ur3hanoi.plan.motion.path_legs import exact_path_legs, profile_legs
 from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 from ur3hanoi.plan.motion.sampling import evaluate
-from ur3hanoi.plan.motion.vertical import PathLimits, place_band
+from ur3hanoi.plan.motion.vertical import PathLimits
 from ur3hanoi.plan.motion.waypoints import Waypoints
-from ur3hanoi.plan.types import KinematicLimits, VerticalPath
+from ur3hanoi.plan.types import KinematicLimits
 from ur3hanoi.station.calibration import Station
-from ur3hanoi.station.grid import ABOVE, ON, contact_point_world
+from ur3hanoi.station.grid import ABOVE, ON
 
-State = tuple[FloatArray, FloatArray, FloatArray]  # joint position [rad], velocity [rad/s], acceleration [rad/s^2]
-Cell = tuple[int, int]  # (via speed index, via acceleration index)
-
-DENSE_RATE_HZ = 1000.0  # [Hz] rate of the forward-kinematics check of every leg
-# [m] kept free below the tolerance at the 1 kHz samples: between two samples the suction point moves sideways by
-# at most its lateral speed (< 0.05 m/s on a leg) times 0.5 ms, i.e. 25 um.
-DENSE_MARGIN_M = 5e-5
-# [m] a leg may dip this far below the contact pose (see the module docstring). 0.5 mm used to be allowed: at the
-# 500 rad/s^3 jerk a carried block then pressed into the stack below and tilted it, leaving the placed block about
-# 1 mm off per placement in MuJoCo (6 blocks on a 10-level grid ended 7.8 mm off); at 0.2 mm they stay within 2 mm
-# and the lab plans are as fast (tests/plan/test_executes.py, bench/bench_executes.py).
-CONTACT_OVERSHOOT_M = 2e-4
 INTERIOR_FRACTIONS: tuple[tuple[float, ...], ...] = ((0.65,), (1 / 3, 2 / 3), (0.25, 0.5, 0.75))  # in order
 LOWER_BOUND_RTOL = 1e-3  # the interior search stops within this of the single-segment lower bound
 # Start of the one-point search, in units (vb, vb / T0): the optima of the lab stations' legs lie at 1.7-1.95 vb
@@ -78,41 +75,7 @@ LOWER_BOUND_RTOL = 1e-3  # the interior search stops within this of the single-s
 ONE_POINT_GUESS = (1.8, -3.0)
 SEARCH_STEP = (0.05, 0.5)  # initial simplex of the search, same units
 MAX_EVALS = 24  # cost evaluations of the search per interior point
-# Numbers of interior points of the path-profile legs (see _profile_legs), tried in order; they are spaced
-# quadratically toward the contact pose, where the joint path curves most (near the arm's singularities).
-PROFILE_POINTS = (4, 6, 8, 12)
 OVERSHOOT_BOUND_M = 5e-3  # [m] a single segment overshooting the contact pose by more marks its cell infeasible
-
-
-@dataclass(frozen=True)
-class Leg:
-    """One vertical leg in one direction: chained joint-space Ruckig segments through ``states``.
-
-    Attributes:
-        states: the K + 2 joint states, above -> interior points -> on (descend) or on -> ... -> above (lift).
-        trajectories: the K + 1 Ruckig trajectories between them (joint space); for the exact path-following
-            fallback, one 1-DoF trajectory of the path coordinate s [m] (``path`` set).
-        duration: [s].
-        deviation_m: worst distance [m] of the suction point from the vertical line (forward kinematics at 1 kHz).
-        path: the slot's path when ``trajectories`` is the 1-DoF path-following trajectory, else None.
-    """
-
-    states: tuple[State, ...]
-    trajectories: tuple[RuckigTrajectory, ...]
-    duration: float
-    deviation_m: float
-    path: VerticalPath | None = None
-
-
-def within_limits(state: State, limits: KinematicLimits) -> bool:
-    """True when a via state is within the limits in Ruckig's sense: acceleration within ``a_max``, and velocity
-    within ``v_max`` even after the acceleration is brought to zero at full jerk (``v + a |a| / (2 j)``).
-    Otherwise Ruckig rejects it as a target, or starts from it with a brake profile that overshoots the velocity
-    limit."""
-    _, v, a = state
-    if not (np.abs(a) <= limits.a_max).all():
-        return False
-    return bool((np.abs(v + a * np.abs(a) / (2.0 * limits.j_max)) <= limits.v_max).all())
 
 
 class SlotLegs:
@@ -133,14 +96,10 @@ class SlotLegs:
         self.path = wp.vertical[slot[0]][slot[1]]
         self.ruckig = ruckig
         self.limits = limits
-        self.tol_m = tol_m
         zero = np.zeros_like(self.path.q[0])
         self.q_above = wp.table[slot[0], slot[1], ABOVE]
         self.on: State = (wp.table[slot[0], slot[1], ON], zero, zero)
-        contact = contact_point_world(station, *slot)
-        self.line_xy = contact[:2]
-        self.z_on = float(contact[2])
-        self.band = place_band(slot[1])  # placing onto a stack: close to the line just above contact
+        self.corridor = Corridor(station, slot, tol_m)
         rest = ruckig.solve(self.q_above, zero, zero, *self.on)
         if rest.trajectory is None:
             raise PlanError(f"Ruckig failed on the rest-to-rest leg of slot {slot}: {rest.reason}")
@@ -189,7 +148,7 @@ class SlotLegs:
             if traj is not None and cell != self.rest_cell:
                 tau = np.linspace(0.0, traj.duration, 25)
                 z = tcp_positions_world(self.station, evaluate(traj, tau)[0])[:, 2]
-                ok = float(np.min(z)) >= self.z_on - OVERSHOOT_BOUND_M
+                ok = float(np.min(z)) >= self.corridor.z_on - OVERSHOOT_BOUND_M
             self._lower[cell] = (traj.duration, traj) if ok and traj is not None else (math.inf, None)
         return self._lower[cell]
 
@@ -267,7 +226,7 @@ class SlotLegs:
         x: list[float] = []
         for f in fractions:
             _, dq, ddq, _ = self.path.evaluate(f * self.path.length_m)
-            k = int(np.argmin(np.abs(z - (self.z_on + (1.0 - f) * self.path.length_m))))
+            k = int(np.argmin(np.abs(z - (self.corridor.z_on + (1.0 - f) * self.path.length_m))))
             sd = float(qd[k] @ dq / (dq @ dq))
             x += [sd, float((qdd[k] - sd * sd * ddq) @ dq / (dq @ dq))]
         return x
@@ -295,95 +254,26 @@ class SlotLegs:
             chain = self.ruckig.chain(states)
             if chain is None:
                 return None, False
-            dev, dip, near = self.corridor(chain)
+            dev, dip, near = self.corridor.measure(chain)
             if dip > CONTACT_OVERSHOOT_M:
                 return None, True
-            if dev > self.tol_m - DENSE_MARGIN_M:  # far off (not at rest): braking too late, more points won't help
-                return None, cell != self.rest_cell and dev > 2.0 * self.tol_m
-            if down and not self.near_ok(near):  # closing in on the line at contact: more points may straighten it
+            tol_m = self.corridor.tol_m
+            if dev > tol_m - DENSE_MARGIN_M:  # far off (not at rest): braking too late, more points won't help
+                return None, cell != self.rest_cell and dev > 2.0 * tol_m
+            if down and not self.corridor.near_ok(near):  # closing in on the line: more points may straighten it
                 return None, False
             legs.append(Leg(tuple(states), tuple(chain), sum(t.duration for t in chain), dev))
         return (legs[0], legs[1]), False
 
-    def _verified(self, states: Sequence[State], down: bool) -> Leg | None:
-        """The chained leg through ``states`` if Ruckig solves it and it passes the corridor check (and, descending,
-        the placing band's), else None."""
-        chain = self.ruckig.chain(states)
-        if chain is None:
-            return None
-        dev, dip, near = self.corridor(chain)
-        if dip > CONTACT_OVERSHOOT_M or dev > self.tol_m - DENSE_MARGIN_M or (down and not self.near_ok(near)):
-            return None
-        return Leg(tuple(states), tuple(chain), sum(t.duration for t in chain), dev)
-
-    def _profile_legs(self, cell: Cell) -> tuple[Leg, Leg] | None:
-        """Legs through many interior points whose states come from the exact path-following timing (a 1-DoF
-        Ruckig of s under :class:`PathLimits`, entering at the cell's via state): for slots where the joint path
-        curves too much for one or two points. Each joint-space segment is at least as fast as the path timing
-        between its points, and with :data:`PROFILE_POINTS` points it stays on the line; no search."""
-        pl = self._path_limits()
-        sigma, acc = self.speeds[cell[0]], self.accels[cell[1]]
-        L = self.path.length_m
-        if sigma > pl.v or abs(acc) > pl.a:
-            return None
-        sol = OfflineRuckig([pl.v], [pl.a], [pl.j]).solve([0.0], [sigma], [acc], [L], [0.0], [0.0])
-        traj = sol.trajectory
-        if traj is None:
-            return None
-        tau = np.linspace(0.0, traj.duration, 4001)
-        s, sd, sdd = (x[:, 0] for x in evaluate(traj, tau))
-        if float(np.min(s)) < -1e-12 or float(np.max(s)) > L + 1e-12:
-            return None
-        for n in PROFILE_POINTS:
-            mid = []
-            for k in range(n):
-                i = min(int(np.searchsorted(s, (1.0 - ((n - k) / (n + 1)) ** 2) * L)), len(s) - 1)
-                q, dq, ddq, _ = self.path.evaluate(float(s[i]))
-                mid.append((q, sd[i] * dq, sd[i] * sd[i] * ddq + sdd[i] * dq))
-            if not all(within_limits(m, self.limits) for m in mid):
-                continue
-            down = self._verified([self.above_state(cell, down=True), *mid, self.on], down=True)
-            rev = [(q, -v, a) for q, v, a in mid[::-1]]
-            up = (self._verified([self.on, *rev, self.above_state(cell, down=False)], down=False) if down is not None
-                  else None)
-            if down is not None and up is not None:
-                return down, up
-        return None
-
     def _path_limits(self) -> PathLimits:
         return PathLimits.for_path(self.path, self.limits)
 
-    def near_ok(self, near: float) -> bool:
-        """True when the worst distance from the line within the slot's placing band (``near`` [m]) is allowed."""
-        return self.band is None or near <= self.band[1] - DENSE_MARGIN_M
-
-    def corridor(self, chain: Sequence[RuckigTrajectory]) -> tuple[float, float, float]:
-        """(worst distance [m] from the vertical line, deepest dip [m] below the contact pose, worst distance [m]
-        from the line within the slot's placing band above the contact pose, 0 without a band) of chained joint
-        trajectories, by forward kinematics at :data:`DENSE_RATE_HZ` (each segment from its start, and its end)."""
-        q = np.concatenate([evaluate(t, np.append(np.arange(0.0, t.duration, 1.0 / DENSE_RATE_HZ), t.duration))[0]
-                            for t in chain])
-        p = tcp_positions_world(self.station, q)
-        d = np.hypot(p[:, 0] - self.line_xy[0], p[:, 1] - self.line_xy[1])
-        low = p[:, 2] <= self.z_on + self.band[0] if self.band is not None else np.zeros(len(d), dtype=bool)
-        near = float(np.max(d[low])) if np.any(low) else 0.0
-        return float(np.max(d)), max(0.0, self.z_on - float(np.min(p[:, 2]))), near
+    def _profile_legs(self, cell: Cell) -> tuple[Leg, Leg] | None:
+        """See :func:`~ur3hanoi.plan.motion.path_legs.profile_legs`."""
+        return profile_legs(self.path, self.corridor, self.ruckig, self.limits, self._path_limits(),
+                            (self.above_state(cell, down=True), self.above_state(cell, down=False)), self.on,
+                            self.speeds[cell[0]], self.accels[cell[1]])
 
     def _exact_path_legs(self) -> tuple[Leg, Leg]:
-        """Rest-to-rest legs following the line exactly: a 1-DoF Ruckig of s under :class:`PathLimits`."""
-        pl = self._path_limits()
-        rk = OfflineRuckig([pl.v], [pl.a], [pl.j])
-        L = self.path.length_m
-        z = [0.0]
-        above: State = (self.q_above, self.on[1], self.on[2])
-        legs = []
-        for s0, s1, states in (([0.0], [L], (above, self.on)), ([L], [0.0], (self.on, above))):
-            sol = rk.solve(s0, z, z, s1, z, z)
-            if sol.trajectory is None:
-                raise PlanError(f"the exact vertical leg of slot {self.slot} failed: {sol.reason}")
-            q = self.path.evaluate_many(evaluate(sol.trajectory, np.linspace(0.0, sol.trajectory.duration, 200))[0]
-                                        [:, 0])[0]
-            p = tcp_positions_world(self.station, q)
-            dev = float(np.max(np.hypot(p[:, 0] - self.line_xy[0], p[:, 1] - self.line_xy[1])))
-            legs.append(Leg(states, (sol.trajectory,), sol.trajectory.duration, dev, self.path))
-        return legs[0], legs[1]
+        """See :func:`~ur3hanoi.plan.motion.path_legs.exact_path_legs`."""
+        return exact_path_legs(self.path, self.corridor, self._path_limits(), self.q_above, self.on, self.slot)

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -202,28 +202,22 @@ def _stacked_paths(paths: Sequence[VerticalPath]) -> _StackedPaths:
     return hit[1]
 
 
-def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
-    """Uniform samples ``t = i / rate_hz`` of the chained segments, with suction, move index and phase.
+class _SegmentRows(NamedTuple):
+    """Where each segment's samples come from: a row of the joint (0) or path (1) profile table (-1: none), its
+    vertical path, its rest pose (a dwell), or a per-sample evaluation (``slow``: a brake pre-profile)."""
 
-    Joint segments: q, qd, qdd, qddd from the Ruckig profiles. Vertical legs: s, sd, sdd, sddd from the path
-    trajectory's profile, mapped to joints by the chain rule. Both are evaluated for all samples at once (see the
-    module docstring); the per-segment Python work is reading each distinct Ruckig trajectory's profiles once.
-    """
-    duration = segments[-1].t_end
-    n = math.ceil(duration * rate_hz - 1e-9) + 1
-    t = np.arange(n) / rate_hz
+    row_of_seg: npt.NDArray[np.intp]  # (2, n_seg)
+    profiles: tuple[list[Any], list[Any]]  # joint, path: the profiles of each distinct trajectory
+    path_of_seg: npt.NDArray[np.intp]  # (n_seg,) index into paths
+    paths: list[VerticalPath]
+    dwell_q: FloatArray  # (6, n_seg) [rad]
+    slow: list[int]
+
+
+def _segment_rows(segments: Sequence[Segment]) -> _SegmentRows:
+    """The table rows of every segment. The builder reuses one Ruckig trajectory for repeated legs, so each
+    distinct trajectory (by identity) is read from the bindings once."""
     n_seg = len(segments)
-    starts = np.array([s.t_start for s in segments])
-    durations = np.array([s.duration for s in segments])
-    # searchsorted <= n_seg, so only the lower bound needs clamping (np.clip has a much larger fixed cost).
-    seg_of = np.maximum(np.searchsorted(starts, t, side="right") - 1, 0)
-    tau = np.minimum(t - starts[seg_of], durations[seg_of])
-    seg_phase = np.array([int(s.phase) for s in segments], dtype=int)
-    phase = seg_phase[seg_of]
-    mi = np.array([s.move_index for s in segments], dtype=int)[seg_of]
-
-    # Table rows per segment (-1: none). The builder reuses one Ruckig trajectory for repeated legs, so each
-    # distinct trajectory (by identity) is read from the bindings once.
     rows: tuple[dict[int, int], dict[int, int]] = ({}, {})  # joint, path: id(trajectory) -> row
     profiles: tuple[list[Any], list[Any]] = ([], [])
     row_of_seg = np.full((2, n_seg), -1, dtype=np.intp)
@@ -231,7 +225,7 @@ def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
     path_list: list[VerticalPath] = []
     path_of_seg = np.zeros(n_seg, dtype=np.intp)
     dwell_q = np.zeros((N_JOINTS, n_seg))
-    slow: list[int] = []  # segments with a brake pre-profile: per-sample at_time
+    slow: list[int] = []
     for k, seg in enumerate(segments):
         traj = seg.trajectory
         if traj is None:
@@ -251,9 +245,33 @@ def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
             path_of_seg[k] = path_rows.setdefault(id(seg.path), len(path_list))
             if path_of_seg[k] == len(path_list):
                 path_list.append(seg.path)
+    return _SegmentRows(row_of_seg, profiles, path_of_seg, path_list, dwell_q, slow)
+
+
+def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
+    """Uniform samples ``t = i / rate_hz`` of the chained segments, with suction, move index and phase.
+
+    Joint segments: q, qd, qdd, qddd from the Ruckig profiles. Vertical legs: s, sd, sdd, sddd from the path
+    trajectory's profile, mapped to joints by the chain rule. Both are evaluated for all samples at once (see the
+    module docstring); the per-segment Python work is reading each distinct Ruckig trajectory's profiles once.
+    """
+    duration = segments[-1].t_end
+    n = math.ceil(duration * rate_hz - 1e-9) + 1
+    t = np.arange(n) / rate_hz
+    starts = np.array([s.t_start for s in segments])
+    durations = np.array([s.duration for s in segments])
+    # searchsorted <= n_seg, so only the lower bound needs clamping (np.clip has a much larger fixed cost).
+    seg_of = np.maximum(np.searchsorted(starts, t, side="right") - 1, 0)
+    tau = np.minimum(t - starts[seg_of], durations[seg_of])
+    seg_phase = np.array([int(s.phase) for s in segments], dtype=int)
+    phase = seg_phase[seg_of]
+    mi = np.array([s.move_index for s in segments], dtype=int)[seg_of]
+
+    rows = _segment_rows(segments)
+    row_of_seg, profiles, path_of_seg = rows.row_of_seg, rows.profiles, rows.path_of_seg
 
     # Joint-major (6, N) work arrays (see _ProfileTable.evaluate), transposed to the contract's (N, 6) at the end.
-    q = dwell_q[:, seg_of]  # the dwells' rest pose; moving samples are overwritten below
+    q = rows.dwell_q[:, seg_of]  # the dwells' rest pose; moving samples are overwritten below
     qd, qdd, qddd = np.zeros((N_JOINTS, n)), np.zeros((N_JOINTS, n)), np.zeros((N_JOINTS, n))
     idx = np.flatnonzero(row_of_seg[0, seg_of] >= 0)
     if idx.size:
@@ -262,7 +280,7 @@ def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
     idx = np.flatnonzero(row_of_seg[1, seg_of] >= 0)
     if idx.size:
         s_all = _ProfileTable.of(profiles[1]).evaluate(seg_of[idx], row_of_seg[1], tau[idx])
-        stacked = _stacked_paths(path_list)
+        stacked = _stacked_paths(rows.paths)
         which = path_of_seg[seg_of[idx]]
         for c in range(0, len(idx), _CHUNK):
             ii, cc = idx[c:c + _CHUNK], slice(c, c + _CHUNK)
@@ -271,7 +289,7 @@ def sample(segments: Sequence[Segment], rate_hz: float) -> Trajectory:
             qd[:, ii] = d1 * sd
             qdd[:, ii] = d2 * sd * sd + d1 * sdd
             qddd[:, ii] = d3 * sd**3 + 3 * d2 * sd * sdd + d1 * sddd
-    for k in slow:
+    for k in rows.slow:
         seg = segments[k]
         assert seg.trajectory is not None
         i0, i1 = np.searchsorted(seg_of, [k, k + 1])

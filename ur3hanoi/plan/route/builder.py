@@ -29,7 +29,7 @@ from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.hanoi import Move, stacks_before_moves
-from ur3hanoi.plan.motion.legs import Leg, State
+from ur3hanoi.plan.motion.corridor import Leg, State
 from ur3hanoi.plan.route import stored
 from ur3hanoi.plan.route.connections import Connection, StationPlanner, station_planner
 from ur3hanoi.plan.types import Phase, PlanConfig, Segment

@@ -28,7 +28,8 @@ from ruckig import Trajectory as RuckigTrajectory
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
 from ur3hanoi.plan.motion.blend import Blender, lateral_direction
-from ur3hanoi.plan.motion.legs import Cell, Leg, SlotLegs, State, within_limits
+from ur3hanoi.plan.motion.corridor import Cell, Leg, State, within_limits
+from ur3hanoi.plan.motion.legs import SlotLegs
 from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 from ur3hanoi.plan.motion.vertical import PathLimits, line_ik
 from ur3hanoi.plan.motion.via import Pair, best_cells
@@ -203,15 +204,15 @@ class StationPlanner:
                 return math.inf if pair is None else pair[1 if exit_leg else 0].duration
             return duration
 
-        start0 = self._start(legs0) if legs0 is not None else (0, 0)
-        start1 = self._start(legs1) if legs1 is not None else (0, 0)
+        start0 = _search_start(legs0) if legs0 is not None else (0, 0)
+        start1 = _search_start(legs1) if legs1 is not None else (0, 0)
         rest0 = legs0.rest_cell if legs0 is not None else (0, 0)
         rest1 = legs1.rest_cell if legs1 is not None else (0, 0)
         ix = best_cells((*n0, *n1), (*start0, *start1), (bound(legs0), bound(legs1)),
                         (exact(legs0, True), exact(legs1, False)), across, (*rest0, *rest1))
         total = exact(legs0, True)((ix[0], ix[1])) + exact(legs1, False)((ix[2], ix[3])) + across(ix)
         if not math.isfinite(total):
-            raise PlanError(f"no feasible connection from {self._name(slot0)} to {self._name(slot1)}: even the "
+            raise PlanError(f"no feasible connection from {_slot_name(slot0)} to {_slot_name(slot1)}: even the "
                             "rest-to-rest motion failed")
         _, states, chain = across_memo[ix]
         assert chain is not None
@@ -240,25 +241,6 @@ class StationPlanner:
         R_world_tcp = self.station.T_world_base.rotation @ robot.fk(q, "tcp").rotation
         return lateral_direction(robot.frame_jacobian_local(q, "tcp"), R_world_tcp, d_world)
 
-    @staticmethod
-    def _start(legs: SlotLegs) -> Cell:
-        """The search start: the cell nearest :data:`SEARCH_START` (grid steps) whose lower bound is finite (the
-        rest cell if none)."""
-        def nearest(values: tuple[float, ...], target: float) -> int:
-            return min(range(len(values)), key=lambda i: abs(values[i] - target))
-        i0 = nearest(legs.speeds, SEARCH_START[0] * legs.vb)
-        j0 = nearest(legs.accels, SEARCH_START[1] * legs.vb / legs.t_rest)
-        n_i, n_j = legs.shape
-        by_distance = sorted((abs(i - i0) + abs(j - j0), i, j) for i in range(n_i) for j in range(n_j))
-        for _, i, j in by_distance:
-            if math.isfinite(legs.lower_bound((i, j))):
-                return i, j
-        return legs.rest_cell
-
-    @staticmethod
-    def _name(slot: Slot | None) -> str:
-        return "home" if slot is None else f"tower {slot[0] + 1} height {slot[1] + 1}"
-
     # ----------------------------------------------------------------------------------------------- references
 
     def rest_to_rest(self, q0: FloatArray, q1: FloatArray) -> float:
@@ -282,9 +264,28 @@ class StationPlanner:
             z = [0.0]
             sol = OfflineRuckig([pl.v], [pl.a], [pl.j]).solve(z, z, z, [vp.length_m], z, z)
             if sol.trajectory is None:
-                raise PlanError(f"the exact vertical leg of {self._name(slot)} failed: {sol.reason}")
+                raise PlanError(f"the exact vertical leg of {_slot_name(slot)} failed: {sol.reason}")
             self._exact_leg[slot] = sol.trajectory.duration
         return self._exact_leg[slot]
+
+
+def _search_start(legs: SlotLegs) -> Cell:
+    """The search start: the cell nearest :data:`SEARCH_START` (grid steps) whose lower bound is finite (the rest
+    cell if none)."""
+    def nearest(values: tuple[float, ...], target: float) -> int:
+        return min(range(len(values)), key=lambda i: abs(values[i] - target))
+    i0 = nearest(legs.speeds, SEARCH_START[0] * legs.vb)
+    j0 = nearest(legs.accels, SEARCH_START[1] * legs.vb / legs.t_rest)
+    n_i, n_j = legs.shape
+    by_distance = sorted((abs(i - i0) + abs(j - j0), i, j) for i in range(n_i) for j in range(n_j))
+    for _, i, j in by_distance:
+        if math.isfinite(legs.lower_bound((i, j))):
+            return i, j
+    return legs.rest_cell
+
+
+def _slot_name(slot: Slot | None) -> str:
+    return "home" if slot is None else f"tower {slot[0] + 1} height {slot[1] + 1}"
 
 
 @lru_cache(maxsize=8)

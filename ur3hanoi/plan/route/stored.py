@@ -26,7 +26,7 @@ import numpy as np
 
 from ur3hanoi.io.cache import cached
 from ur3hanoi.plan.cache_key import station_inputs
-from ur3hanoi.plan.motion.legs import Leg, State
+from ur3hanoi.plan.motion.corridor import Leg, State
 from ur3hanoi.plan.motion.waypoints import geometry_key
 from ur3hanoi.plan.route.connections import Connection, ConnectionKey, Slot, StationPlanner
 
