@@ -39,7 +39,8 @@ def _build(site: Path) -> subprocess.CompletedProcess[str]:
 @pytest.fixture(scope="session")
 def built_site(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, subprocess.CompletedProcess[str]]:
     """The site, built once per test run into a temporary folder (shared by the xdist workers under a lock)."""
-    shared = tmp_path_factory.getbasetemp().parent
+    base = tmp_path_factory.getbasetemp()
+    shared = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base  # the run's folder, not older runs'
     site, done = shared / "docs-site", shared / "docs-site.log"
     with open(shared / "docs-site.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
@@ -252,7 +253,8 @@ def test_the_home_page_shows_the_header_the_text_and_the_replay_picture(built_si
     # The replay picture: its sky-blue background and the brown table (only the picture has them).
     sky = (body[..., 2] > 200) & (body[..., 0] < 170) & (body[..., 2] - body[..., 0] > 60)
     table = (np.abs(body - np.array((140, 100, 70))) < 40).all(axis=-1)
-    assert sky.sum() > 20000 and table.sum() > 5000, (sky.sum(), table.sum())
+    assert sky.sum() > 20000 and table.sum() > 5000, f"the replay picture is not drawn: {sky.sum()} sky, " \
+                                                     f"{table.sum()} table px"
 
 
 def test_the_audit_page_shows_the_audit_picture(built_site, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
