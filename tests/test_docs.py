@@ -10,7 +10,6 @@ import fcntl
 import importlib
 import os
 import re
-import shutil
 import subprocess
 import sys
 from functools import cache
@@ -21,7 +20,7 @@ import pytest
 from PIL import Image
 
 from tests.browser_support import chromium, offline_prefix
-from tests.docs_support import DOCS, REPO, doc_pages, page_name, shell_blocks
+from tests.docs_support import REPO, doc_pages, page_name, shell_blocks
 
 INCLUDED = (REPO / "ur3hanoi" / "stations" / "README.md", REPO / "bench" / "REPORT.md")
 """Files the site includes (pymdownx.snippets): named things in them are checked like the pages'."""
@@ -62,20 +61,27 @@ def test_the_site_builds_in_strict_mode_without_a_warning(built_site) -> None:  
     assert (site / "search" / "search_index.js").is_file()  # the offline plugin's search, from file://
 
 
-def test_a_broken_link_fails_the_strict_build(tmp_path: Path) -> None:
-    """The build the suite relies on does fail: a copy of the docs with one link to a page that does not exist."""
-    copy = tmp_path / "repo"
-    shutil.copytree(DOCS, copy / "docs", symlinks=True)
-    for name in ("mkdocs.yml", "README.md"):
-        shutil.copy(REPO / name, copy / name)
-    for name in ("tools", "ur3hanoi", "bench", "notebooks"):
-        (copy / name).symlink_to(REPO / name)
-    page = copy / "docs" / "frames.md"
-    page.write_text(page.read_text() + "\nSee [the missing page](no-such-page.md).\n")
+def test_a_broken_link_or_anchor_fails_the_strict_build(tmp_path: Path) -> None:
+    """The site's strictness (its validation settings and --strict) does fail a build: a two-page site with the
+    same settings, without the slow plugins, whose home page links to a missing page and a missing anchor."""
+    import yaml
+
+    config = yaml.safe_load((REPO / "mkdocs.yml").read_text())
+    config.update(docs_dir=str(tmp_path / "docs"), site_dir=str(tmp_path / "site"), nav=["index.md", "other.md"],
+                  plugins=["search", "offline"], hooks=[], extra={})
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "docs" / "other.md").write_text("# Other\n\n## A heading\n")
+    (tmp_path / "mkdocs.yml").write_text(yaml.safe_dump(config))
     env = dict(os.environ, NO_MKDOCS_2_WARNING="1")
-    proc = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
-                          cwd=copy, env=env, capture_output=True, text=True, timeout=600)
-    assert proc.returncode != 0 and "no-such-page.md" in proc.stderr
+    for link, words in (("[ok](other.md#a-heading)", None), ("[missing](no-such-page.md)", "no-such-page.md"),
+                        ("[anchor](other.md#no-such-anchor)", "no-such-anchor")):
+        (tmp_path / "docs" / "index.md").write_text(f"# Home\n\nSee {link}.\n")
+        proc = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "-f", str(tmp_path / "mkdocs.yml")],
+                              env=env, capture_output=True, text=True, timeout=300)
+        if words is None:
+            assert proc.returncode == 0, proc.stderr[-2000:]
+        else:
+            assert proc.returncode != 0 and words in proc.stderr, proc.stderr[-2000:]
 
 
 def test_the_built_pages_fetch_nothing_from_the_network(built_site) -> None:  # type: ignore[no-untyped-def]
@@ -199,11 +205,13 @@ def test_everything_the_pages_name_exists() -> None:
 
 
 def test_a_page_naming_what_does_not_exist_is_caught() -> None:
-    text = ("See `ur3hanoi/no_such.py`, `no_such_folder/NAME.py`, `tools/no_such/NAME.py` and `ur3hanoi.station.NoSuchThing`; run `ur3hanoi plan --no-such-option`, "
+    text = ("See `ur3hanoi/no_such.py`, `tools/no_such/NAME.py` and "
+            "`ur3hanoi.station.NoSuchThing`; run `ur3hanoi plan --no-such-option`, "
             "or `solve --fit` (an option of check-table only), then --also-missing.\n![a picture](no_such.png)\n"
             "ur3hanoi tables lab_sim --key sim_pos --nope -o x.yaml\n")
     problems = "\n".join(named_problems("docs/page.md", text))
-    for words in ("path ur3hanoi/no_such.py does not exist", "path tools/no_such/NAME.py does not exist", "ur3hanoi.station.NoSuchThing is no module",
+    for words in ("path ur3hanoi/no_such.py does not exist", "path tools/no_such/NAME.py does not exist",
+                  "ur3hanoi.station.NoSuchThing is no module",
                   "--no-such-option is no option of ur3hanoi plan", "--fit is no option of ur3hanoi solve",
                   "--also-missing is no option of any ur3hanoi command", "picture no_such.png does not exist",
                   "--nope is no option of ur3hanoi tables"):
