@@ -110,6 +110,16 @@ def test_the_cli_page_is_the_parsers_help() -> None:
     assert render(page) == page, "docs/cli.md is stale: run `make docs`"
 
 
+def test_the_example_table_is_what_the_pictures_script_makes(tmp_path: Path) -> None:
+    """docs/examples/hand_recorded.yaml (the audit page's table and picture) comes from tools/make_pictures.py."""
+    sys.path.insert(0, str(REPO / "tools"))
+    try:
+        from make_pictures import EXAMPLE, hand_recorded_table
+    finally:
+        sys.path.pop(0)
+    assert hand_recorded_table(tmp_path) == EXAMPLE.read_text(), "stale: run `make pictures`"
+
+
 # ------------------------------------------------------------------------------------------------ named things
 
 TOPICS = {"ur3hanoi/spawn", "ur3hanoi/remove_block"}

@@ -44,8 +44,9 @@ def ur3hanoi(*args: str, ok: tuple[int, ...] = (0,), cwd: Path = REPO) -> subpro
     return proc
 
 
-def hand_recorded_table(tmp: Path) -> None:
-    """The generated lab_real table as a person would record it: jitter, pendant rounding, one shoulder typo."""
+def hand_recorded_table(tmp: Path) -> str:
+    """The generated lab_real table as a person would record it: jitter, pendant rounding, one shoulder typo (the
+    text of ``docs/examples/hand_recorded.yaml``)."""
     generated = tmp / "generated.yaml"
     ur3hanoi("tables", "lab_real", "--key", "real_pos", "-o", str(generated))
     q = np.array(yaml.safe_load(generated.read_text())["real_pos"], dtype=float)
@@ -62,8 +63,7 @@ def hand_recorded_table(tmp: Path) -> None:
                 rows.append(f"{lead}[{values}]  # tower {t + 1} height {h + 1} {name}")
     head = ("# A hand-recorded real_pos table of the example station lab_real, as students record it (made by\n"
             "# tools/make_pictures.py: the generated table with 0.15 deg of jitter per joint and one typo).\n")
-    EXAMPLE.parent.mkdir(exist_ok=True)
-    EXAMPLE.write_text(head + "real_pos:\n" + "\n".join(rows) + "\n")
+    return head + "real_pos:\n" + "\n".join(rows) + "\n"
 
 
 def audit_picture() -> None:
@@ -111,7 +111,8 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="ur3hanoi-pictures-") as name:
         tmp = Path(name)
         if only in (None, "audit"):
-            hand_recorded_table(tmp)
+            EXAMPLE.parent.mkdir(exist_ok=True)
+            EXAMPLE.write_text(hand_recorded_table(tmp))
             audit_picture()
         if only in (None, "plan"):
             plan_picture()
