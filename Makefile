@@ -5,8 +5,9 @@ PY ?= python3
 VENV ?= .venv
 STAMP := $(VENV)/.installed
 export MUJOCO_GL ?= egl
+export NO_MKDOCS_2_WARNING ?= 1  # Material's end-of-life notice on every docs build
 
-.PHONY: solve test test-fast venv lint bench tables docs clean lab
+.PHONY: solve test test-fast venv lint bench tables docs pictures clean lab
 
 $(STAMP): pyproject.toml requirements.lock tools/ensure-system-deps.sh
 	@$(PY) -c 'import sys; ok = (3, 11) <= sys.version_info[:2] <= (3, 13); ok or print(f"ur3hanoi: error: Python {sys.version.split()[0]} ($(PY)) is not supported: use Python 3.11, 3.12 or 3.13, e.g. make PY=python3.12"); sys.exit(not ok)'
@@ -37,8 +38,14 @@ tables: $(STAMP)
 	$(VENV)/bin/ur3hanoi tables lab_sim --key sim_pos -o tables/lab2_data.yaml
 	$(VENV)/bin/ur3hanoi tables lab_real --key real_pos -o tables/lab2_data.yaml
 
+# The documentation site, built offline into site/ (not committed): open site/index.html. The command-line page is
+# rewritten from the parser first; the pictures come from real runs (make pictures).
 docs: $(STAMP)
-	$(VENV)/bin/python tools/update_readme_cli.py
+	$(VENV)/bin/python tools/update_cli_page.py
+	$(VENV)/bin/mkdocs build --strict --site-dir site
+
+pictures: $(STAMP)
+	$(VENV)/bin/python tools/make_pictures.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .

@@ -360,16 +360,6 @@ def test_console_script_entry_point() -> None:
     assert out.stdout.startswith("ur3hanoi ")
 
 
-def test_readme_cli_reference_is_up_to_date() -> None:
-    sys.path.insert(0, str(REPO / "tools"))
-    try:
-        from update_readme_cli import render
-    finally:
-        sys.path.pop(0)
-    readme = (REPO / "README.md").read_text()
-    assert render(readme) == readme, "README CLI reference is stale: run `make docs`"
-
-
 def test_solve_render_outputs_are_checked_before_simulating(tmp_path: Path,
                                                              capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["solve", "--start", "1", "--end", "3", "--video", str(tmp_path)]) == 2

@@ -7,7 +7,6 @@ import colorsys
 import json
 import math
 import re
-import shutil
 import subprocess
 from functools import cache
 from pathlib import Path
@@ -17,6 +16,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from tests.support.browser_support import chromium, offline_prefix
 from tests.support.sim_helpers import STATIONS, planned
 from ur3hanoi.errors import SuctionFaultError
 from ur3hanoi.replay import PoseRecorder, SinkTee, page_html, record_plan, write_plan_replay, write_run_replay
@@ -154,25 +154,10 @@ def test_page_html_escapes_the_title() -> None:
 # ------------------------------------------------------------------------------------------------ in a browser
 
 
-def _offline_prefix() -> list[str]:
-    """A command prefix that runs a program without any network (a new network namespace), or skip."""
-    for prefix in (["unshare", "-n"], ["unshare", "-rn"]):
-        if shutil.which(prefix[0]) and subprocess.run([*prefix, "true"], capture_output=True).returncode == 0:
-            return prefix
-    pytest.skip("cannot make a network namespace (unshare -n) to open the page offline")
-
-
-def _chromium() -> str:
-    exe = shutil.which("chromium") or shutil.which("chromium-browser")
-    if exe is None:
-        pytest.skip("Debian's chromium is not installed (tools/ensure-system-deps.sh installs it)")
-    return exe
-
-
 def _browse(url: str, tmp: Path, name: str, mode: str) -> subprocess.CompletedProcess[str]:
     """Open ``url`` in headless chromium with the network off: ``mode`` "screenshot" (800x600 PNG at
     tmp/name.png) or "dump" (the DOM after load, on stdout)."""
-    args = [*_offline_prefix(), _chromium(), "--headless", "--no-sandbox", "--use-angle=swiftshader",
+    args = [*offline_prefix(), chromium(), "--headless", "--no-sandbox", "--use-angle=swiftshader",
             "--enable-unsafe-swiftshader", "--no-first-run", f"--user-data-dir={tmp / ('profile-' + name)}",
             "--window-size=800,600", "--hide-scrollbars"]
     args += [f"--screenshot={tmp / (name + '.png')}"] if mode == "screenshot" else ["--dump-dom"]

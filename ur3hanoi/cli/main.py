@@ -59,7 +59,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 
 def help_markdown(width: int = 100) -> str:
-    """The README's CLI reference: ``--help`` of the command and of every subcommand, at a fixed width."""
+    """The command-line reference (``docs/cli.md``): ``--help`` of the command and of every subcommand, at a fixed
+    width, one section per subcommand."""
     old = os.environ.get("COLUMNS")
     os.environ["COLUMNS"] = str(width)  # argparse wraps to the terminal width: pin it for a stable text
     try:
@@ -67,7 +68,7 @@ def help_markdown(width: int = 100) -> str:
         parts = ["```text", "$ ur3hanoi --help", parser.format_help().rstrip(), "```"]
         sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
         for name, p in sub.choices.items():
-            parts += ["", f"#### `ur3hanoi {name}`", "", "```text", p.format_help().rstrip(), "```"]
+            parts += ["", f"## `ur3hanoi {name}`", "", "```text", p.format_help().rstrip(), "```"]
     finally:
         if old is None:
             del os.environ["COLUMNS"]

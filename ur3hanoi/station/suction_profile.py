@@ -15,7 +15,7 @@ levels differ between the course's Gazebo simulator and real stations, so a stat
   (1.875 V) and 0.35 V clear of its ends: 17 standard deviations of its 0.02 V noise, so no program with a
   threshold in the band ever reads a false "missing" or "held". Off stays the simulator's 1.05 V (no vacuum at
   all). These are a consistent stand-in, not a measurement: measure your station's own levels and set them
-  (README, "Suction feedback profiles").
+  (the manual's page "Suction feedback profiles", ``docs/suction.md``).
 
 Nothing here imports MuJoCo: the calibration (:mod:`ur3hanoi.station.calibration`) carries a profile, and the suction
 model (:mod:`ur3hanoi.sim.suction`) reads it.

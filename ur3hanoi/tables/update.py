@@ -38,7 +38,8 @@ def write_sections(path: str | Path, sections: Sections, inputs: Sequence[str | 
         TableError: ``sections.key`` is not a table key, or the existing file is not valid YAML or its top level is
             not a mapping, or the result would not read back.
         OutputError: ``path`` cannot be written (an input file, a directory, a device, no space...).
-        In both cases the file is left byte-identical.
+
+    In both cases the file is left byte-identical.
     """
     key = sections.key
     check_key(key)

@@ -55,7 +55,8 @@ def write_table(path: str | Path, table: Table, key: str, calibration_label: str
         TableError: ``key`` is not a table key, or the existing file is not valid YAML or its top level is not
             a mapping (see :func:`~ur3hanoi.tables.update.write_sections`).
         OutputError: ``path`` cannot be written (an input file, a directory, a device, no space...).
-        In both cases the file is left byte-identical.
+
+    In both cases the file is left byte-identical.
     """
     check_key(key)
     sections = table_sections(table, key, calibration_label, convention)
