@@ -10,8 +10,9 @@ import pytest
 
 from ur3hanoi.errors import Ur3HanoiError
 from ur3hanoi.robot.chain import axis_rotation, parse_chain, rigid_inverse, rpy_matrix
-from ur3hanoi.robot.model import JOINT_NAMES, ToolOffset, Ur3Model, urdf_text
+from ur3hanoi.robot.model import Ur3Model
 from ur3hanoi.robot.registry import UR3, UR3E
+from ur3hanoi.robot.urdf import JOINT_NAMES, ToolOffset, urdf_text
 
 TOOLS = (
     ToolOffset("ee_link", (0.059, 0.0535, 0.0), (0.0, math.pi / 2, 0.0)),  # the lab's suction cup

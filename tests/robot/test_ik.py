@@ -13,25 +13,28 @@ from hypothesis import strategies as st
 
 import ur3hanoi.robot.model
 from ur3hanoi.errors import IKError, Ur3HanoiError
+from ur3hanoi.robot.dh import dh_fk
 from ur3hanoi.robot.ik import (
     BRANCHES,
+    analytic_ik,
+    branch_of,
+    closed_form_result,
+    nearest_equivalent,
+    solve_on_branch,
+    solve_table_on_branch,
+    wrap_angle,
+)
+from ur3hanoi.robot.ik_solvers import (
     CLOSED_FORM,
     ORIENTATION_TOL,
     POSITION_TOL,
     SOLVERS,
     IKResult,
     IKSolver,
-    analytic_ik,
-    branch_of,
-    closed_form_result,
     make_solver,
-    nearest_equivalent,
     pose_errors,
-    solve_on_branch,
-    solve_table_on_branch,
-    wrap_angle,
 )
-from ur3hanoi.robot.model import Q_HOME_LAB, JointLimits, Ur3Model, dh_fk, load_ur3
+from ur3hanoi.robot.model import Q_HOME_LAB, JointLimits, Ur3Model, load_ur3
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import R_world_tcp_down, T_base_tcp
 

@@ -23,9 +23,9 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 
-from ur3hanoi.robot.model import JOINT_NAMES, Q_HOME_LAB
+from ur3hanoi.robot.model import Q_HOME_LAB
 from ur3hanoi.robot.registry import RobotDescription
-from ur3hanoi.robot.urdf import LINKS, link_inertias, link_shapes, ur_layout
+from ur3hanoi.robot.urdf import JOINT_NAMES, LINKS, link_inertias, link_shapes, ur_layout
 from ur3hanoi.sim.model import DEFAULT_TOOL, DRIVES, T_ee_tcp, cup_geometry, quat_wxyz
 
 _LINK_RGBA = {  # e-Series: blue joint caps, grey tubes

@@ -48,8 +48,9 @@ from ur3hanoi.io.schema import Choice, Field, ListOf, Number, Record, Text, Vect
 from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
 from ur3hanoi.robot.chain import rpy_matrix
-from ur3hanoi.robot.model import FLANGE_FRAMES, N_JOINTS, JointLimits, ToolOffset
-from ur3hanoi.robot.registry import DEFAULT_ROBOT, ROBOTS, RobotDescription
+from ur3hanoi.robot.model import JointLimits
+from ur3hanoi.robot.registry import DEFAULT_ROBOT, N_JOINTS, ROBOTS, RobotDescription
+from ur3hanoi.robot.urdf import FLANGE_FRAMES, ToolOffset
 from ur3hanoi.station.suction_profile import (
     AIN_RANGE_V,
     DEFAULT_PROFILE,
