@@ -43,6 +43,19 @@ def test_chain_reads_the_ur3_joints_and_frames() -> None:
     assert chain.frames["base_link"][0] == 0
 
 
+def test_a_chain_with_a_base_reports_in_it() -> None:
+    """The model's chain reports in the controller ``base``: the root link's FK, then the base's pose of the root."""
+    from ur3hanoi.robot.model import H_BASE_BASELINK
+
+    model = Ur3Model(TOOLS[1])
+    in_root = parse_chain(model.urdf)
+    qs = np.random.default_rng(4).uniform(-2 * math.pi, 2 * math.pi, size=(20, 6))
+    for frame in FRAMES:
+        np.testing.assert_array_equal(model.chain.fk(qs, frame), H_BASE_BASELINK @ in_root.fk(qs, frame))
+        np.testing.assert_array_equal(model.chain.fk(qs[3], frame), model.fk_matrix(qs[3], frame))
+    assert not np.allclose(in_root.fk(qs, "tcp"), model.chain.fk(qs, "tcp"))
+
+
 def test_rotations_are_proper() -> None:
     rng = np.random.default_rng(3)
     for rpy in rng.uniform(-math.pi, math.pi, size=(50, 3)):

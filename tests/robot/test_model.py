@@ -98,11 +98,3 @@ def test_unknown_frame_error_lists_frames() -> None:
     with pytest.raises(Ur3HanoiError, match="expected one of"):
         load_ur3().fk(np.zeros(6), "flange")
 
-
-def test_batched_dh_fk_equals_single() -> None:
-    rng = np.random.default_rng(3)
-    qs = rng.uniform(-math.pi, math.pi, size=(50, 6))
-    batch = dh_fk(qs)
-    assert batch.shape == (50, 4, 4)
-    for q, T in zip(qs, batch, strict=True):
-        assert np.array_equal(dh_fk(q), T)
