@@ -146,6 +146,17 @@ class JointPlacement:
 
 
 @dataclass(frozen=True)
+class FixedFrame:
+    """A link of the UR layout fixed to ``parent`` by the joint ``joint`` at ``xyz`` [m] / URDF ``rpy`` [rad]."""
+
+    joint: str
+    parent: str
+    child: str
+    xyz: Vec3
+    rpy: Vec3
+
+
+@dataclass(frozen=True)
 class Cylinder:
     """A link shape: a cylinder of ``radius`` [m] from ``p0`` to ``p1`` [m, link frame]."""
 
@@ -182,6 +193,18 @@ def ur_layout(r: RobotDescription) -> tuple[JointPlacement, ...]:
         JointPlacement(JOINT_NAMES[3], LINKS[3], LINKS[4], (0.0, 0.0, -a[2]), (0.0, _HALF_PI, 0.0), y),
         JointPlacement(JOINT_NAMES[4], LINKS[4], LINKS[5], (0.0, d[3] - s + e, 0.0), (0.0, 0.0, 0.0), z),
         JointPlacement(JOINT_NAMES[5], LINKS[5], LINKS[6], (0.0, 0.0, d[4]), (0.0, 0.0, 0.0), y),
+    )
+
+
+def fixed_frames(r: RobotDescription) -> tuple[FixedFrame, ...]:
+    """The fixed frames of the UR layout for ``r``'s DH table: ``ee_link`` (x along the tool axis) on
+    ``wrist_3_link`` at the flange, ``base`` (the controller's DH base) on ``base_link``, ``tool0`` (the DH flange
+    frame, z along the tool axis) on ``wrist_3_link``."""
+    d6 = r.dh.d[5]
+    return (
+        FixedFrame("ee_fixed_joint", LINKS[6], "ee_link", (0.0, d6, 0.0), (0.0, 0.0, _HALF_PI)),
+        FixedFrame("base_link-base_fixed_joint", LINKS[0], "base", (0.0, 0.0, 0.0), (0.0, 0.0, -math.pi)),
+        FixedFrame("wrist_3_link-tool0_fixed_joint", LINKS[6], "tool0", (0.0, d6, 0.0), (-_HALF_PI, 0.0, 0.0)),
     )
 
 
@@ -259,6 +282,11 @@ def _v(v: FloatArray | Vec3) -> str:
     return " ".join(_f(float(x)) for x in v)
 
 
+def _v0(v: Vec3) -> str:
+    """Like :func:`_v`, zeros written ``0``."""
+    return " ".join("0" if x == 0.0 else _f(x) for x in v)
+
+
 def urdf_from_dh(r: RobotDescription) -> str:
     """The URDF text of ``r`` in the UR layout (see the module docstring); deterministic."""
     import pinocchio as pin
@@ -290,20 +318,11 @@ def urdf_from_dh(r: RobotDescription) -> str:
                   f'    <limit effort="{_f(r.torque[i])}" lower="{_f(-2 * math.pi)}" upper="{_f(2 * math.pi)}" '
                   f'velocity="{_f(r.v_max[i])}"/>',
                   "  </joint>"]
-    d6 = r.dh.d[5]
-    lines += [
-        '  <link name="ee_link"/>',
-        '  <joint name="ee_fixed_joint" type="fixed"><parent link="wrist_3_link"/><child link="ee_link"/>'
-        f'<origin xyz="0 {_f(d6)} 0" rpy="0 0 {_f(_HALF_PI)}"/></joint>',
-        '  <link name="base"/>',
-        '  <joint name="base_link-base_fixed_joint" type="fixed"><parent link="base_link"/><child link="base"/>'
-        f'<origin xyz="0 0 0" rpy="0 0 {_f(-math.pi)}"/></joint>',
-        '  <link name="tool0"/>',
-        '  <joint name="wrist_3_link-tool0_fixed_joint" type="fixed"><parent link="wrist_3_link"/>'
-        f'<child link="tool0"/><origin xyz="0 {_f(d6)} 0" rpy="{_f(-_HALF_PI)} 0 0"/></joint>',
-        "</robot>",
-    ]
-    return "\n".join(lines) + "\n"
+    for f in fixed_frames(r):
+        lines += [f'  <link name="{f.child}"/>',
+                  f'  <joint name="{f.joint}" type="fixed"><parent link="{f.parent}"/><child link="{f.child}"/>'
+                  f'<origin xyz="{_v0(f.xyz)}" rpy="{_v0(f.rpy)}"/></joint>']
+    return "\n".join([*lines, "</robot>"]) + "\n"
 
 
 __all__ = [
@@ -311,9 +330,11 @@ __all__ = [
     "JOINT_NAMES",
     "LINKS",
     "Cylinder",
+    "FixedFrame",
     "JointPlacement",
     "LinkInertia",
     "ToolOffset",
+    "fixed_frames",
     "link_from_dh",
     "link_inertias",
     "link_shapes",
