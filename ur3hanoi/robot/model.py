@@ -259,10 +259,9 @@ def load_ur3(tool: ToolOffset | None = None, limits: JointLimits | None = None,
     return Ur3Model(tool, limits, robot)
 
 
-# FLANGE_FRAMES, JOINT_NAMES, ToolOffset, package_dir, urdf_path, urdf_text (ur3hanoi.robot.urdf) and N_JOINTS
-# (ur3hanoi.robot.registry) are listed here too while sim/ and interface/ still import them from this module.
+# JOINT_NAMES, ToolOffset, package_dir, urdf_path (homes: ur3hanoi.robot.urdf) and N_JOINTS (ur3hanoi.robot.registry)
+# are listed here too while sim/ and interface/ still import them from this module (issue 27).
 __all__ = [
-    "FLANGE_FRAMES",
     "H_BASELINK_BASE",
     "H_BASE_BASELINK",
     "JOINT_NAMES",
@@ -275,5 +274,4 @@ __all__ = [
     "load_ur3",
     "package_dir",
     "urdf_path",
-    "urdf_text",
 ]
