@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from ur3hanoi.io.resources import stations_dir
-from ur3hanoi.robot.ik import SOLVERS, branch_of, make_solver, solve_on_branch
+from ur3hanoi.robot.ik import branch_of, solve_on_branch
+from ur3hanoi.robot.ik_solvers import SOLVERS, make_solver
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import load_station
 from ur3hanoi.station.grid import T_base_tcp

@@ -134,16 +134,8 @@ def per_call_us(fn: Callable[[], object], repeats: int) -> float:
 
 
 def bench_ik_station(name: str, repeats: int) -> list[str]:
-    from ur3hanoi.robot.ik import (
-        SOLVERS,
-        IKSolver,
-        analytic_ik,
-        branch_of,
-        closed_form_result,
-        make_solver,
-        solve_on_branch,
-        solve_table_on_branch,
-    )
+    from ur3hanoi.robot.ik import analytic_ik, branch_of, closed_form_result, solve_on_branch, solve_table_on_branch
+    from ur3hanoi.robot.ik_solvers import SOLVERS, IKSolver, make_solver
     from ur3hanoi.robot.model import load_ur3
     from ur3hanoi.station.calibration import load_station
     from ur3hanoi.station.grid import T_base_tcp

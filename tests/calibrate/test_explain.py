@@ -74,7 +74,8 @@ def test_joint_typo_uses_the_position_when_the_heading_was_recorded_sloppily(lab
     # point's position (lever 0.3 m about joint 1) brings it within half a degree.
     import pinocchio as pin
 
-    from ur3hanoi.robot.ik import make_solver, solve_on_branch
+    from ur3hanoi.robot.ik import solve_on_branch
+    from ur3hanoi.robot.ik_solvers import make_solver
 
     target = T_world_tcp(lab_real, 1, 1, ON)
     turned = pin.SE3(target.rotation @ pin.utils.rotate("z", math.radians(1.5)), target.translation)

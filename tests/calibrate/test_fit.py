@@ -20,7 +20,8 @@ from ur3hanoi.calibrate import MIN_SUSPECT_MM, CalibrationFit, fit_station
 from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints, taught_from_table
 from ur3hanoi.cli import main
 from ur3hanoi.errors import IKError, TaughtPointsError
-from ur3hanoi.robot.ik import make_solver, solve_on_branch
+from ur3hanoi.robot.ik import solve_on_branch
+from ur3hanoi.robot.ik_solvers import make_solver
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station, load_station, station_to_dict
 from ur3hanoi.station.grid import ABOVE, ON, T_world_tcp

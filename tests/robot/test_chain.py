@@ -10,8 +10,9 @@ import pytest
 
 from ur3hanoi.errors import Ur3HanoiError
 from ur3hanoi.robot.chain import axis_rotation, parse_chain, rigid_inverse, rpy_matrix
-from ur3hanoi.robot.model import JOINT_NAMES, ToolOffset, Ur3Model, urdf_text
+from ur3hanoi.robot.model import Ur3Model
 from ur3hanoi.robot.registry import UR3, UR3E
+from ur3hanoi.robot.urdf import JOINT_NAMES, ToolOffset, urdf_text
 
 TOOLS = (
     ToolOffset("ee_link", (0.059, 0.0535, 0.0), (0.0, math.pi / 2, 0.0)),  # the lab's suction cup
@@ -40,6 +41,19 @@ def test_chain_reads_the_ur3_joints_and_frames() -> None:
     assert set(FRAMES) <= set(chain.frames)
     assert chain.frames["tcp"][0] == chain.frames["tool0"][0] == 6  # fixed to the last joint's link
     assert chain.frames["base_link"][0] == 0
+
+
+def test_a_chain_with_a_base_reports_in_it() -> None:
+    """The model's chain reports in the controller ``base``: the root link's FK, then the base's pose of the root."""
+    from ur3hanoi.robot.model import H_BASE_BASELINK
+
+    model = Ur3Model(TOOLS[1])
+    in_root = parse_chain(model.urdf)
+    qs = np.random.default_rng(4).uniform(-2 * math.pi, 2 * math.pi, size=(20, 6))
+    for frame in FRAMES:
+        np.testing.assert_array_equal(model.chain.fk(qs, frame), H_BASE_BASELINK @ in_root.fk(qs, frame))
+        np.testing.assert_array_equal(model.chain.fk(qs[3], frame), model.fk_matrix(qs[3], frame))
+    assert not np.allclose(in_root.fk(qs, "tcp"), model.chain.fk(qs, "tcp"))
 
 
 def test_rotations_are_proper() -> None:

@@ -12,50 +12,32 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import ur3hanoi.robot.model
-from ur3hanoi.errors import IKError, Ur3HanoiError
+from tests.robot.conftest import HOME_BRANCH, Q_HOME
+from ur3hanoi.errors import IKError
+from ur3hanoi.robot.dh import dh_fk
 from ur3hanoi.robot.ik import (
     BRANCHES,
+    analytic_ik,
+    branch_of,
+    closed_form_result,
+    nearest_equivalent,
+    solve_on_branch,
+    solve_table_on_branch,
+    wrap_angle,
+)
+from ur3hanoi.robot.ik_solvers import (
     CLOSED_FORM,
     ORIENTATION_TOL,
     POSITION_TOL,
     SOLVERS,
     IKResult,
     IKSolver,
-    analytic_ik,
-    branch_of,
-    closed_form_result,
     make_solver,
-    nearest_equivalent,
     pose_errors,
-    solve_on_branch,
-    solve_table_on_branch,
-    wrap_angle,
 )
-from ur3hanoi.robot.model import Q_HOME_LAB, JointLimits, Ur3Model, dh_fk, load_ur3
+from ur3hanoi.robot.model import JointLimits, Ur3Model, load_ur3
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import R_world_tcp_down, T_base_tcp
-
-Q_HOME = np.array(Q_HOME_LAB)
-HOME_BRANCH = branch_of(Q_HOME)
-
-
-@pytest.fixture(scope="module")
-def robot(lab_sim: Station) -> Ur3Model:
-    return load_ur3(lab_sim.tool, lab_sim.limits)
-
-
-@pytest.fixture(scope="module")
-def downward_poses(robot: Ur3Model) -> list[pin.SE3]:
-    """200 seeded, reachable TCP poses pointing straight down with random yaw (targets in `base`)."""
-    rng = np.random.default_rng(1234)
-    T_tcp_tool0 = robot.T_flange_tcp("tool0").inverse()
-    poses: list[pin.SE3] = []
-    while len(poses) < 200:
-        p = np.array([rng.uniform(-0.45, 0.45), rng.uniform(-0.45, 0.45), rng.uniform(-0.05, 0.35)])
-        T = pin.SE3(R_world_tcp_down(rng.uniform(-math.pi, math.pi)), p)
-        if HOME_BRANCH in analytic_ik(T * T_tcp_tool0, only=HOME_BRANCH):
-            poses.append(T)
-    return poses
 
 
 def test_analytic_ik_all_branches_reproduce_the_pose() -> None:
@@ -91,22 +73,6 @@ def test_round_trip_200_downward_poses(robot: Ur3Model, downward_poses: list[pin
         assert branch_of(res.q) == HOME_BRANCH
     assert worst_p <= POSITION_TOL
     assert worst_r <= ORIENTATION_TOL
-
-
-@pytest.mark.parametrize("solver_name", SOLVERS)
-def test_numerical_solver_converges_from_a_perturbed_seed(robot: Ur3Model, downward_poses: list[pin.SE3],
-                                                          solver_name: str) -> None:
-    """The numerical solvers do real work: from a seed 0.1 rad off they converge to 1e-9 on their own."""
-    solver = make_solver(solver_name, robot)
-    rng = np.random.default_rng(5)
-    T_tcp_tool0 = robot.T_flange_tcp("tool0").inverse()
-    converged = 0
-    for T in downward_poses[:100]:
-        q_true = analytic_ik(T * T_tcp_tool0, only=HOME_BRANCH)[HOME_BRANCH]
-        res = solver.solve(T, q_true + rng.normal(0.0, 0.1, 6))
-        assert res.iterations > 1
-        converged += res.converged
-    assert converged >= 98
 
 
 def test_solvers_agree_on_random_poses(robot: Ur3Model, downward_poses: list[pin.SE3]) -> None:
@@ -184,11 +150,6 @@ def test_pose_off_home_branch_is_reported(robot: Ur3Model) -> None:
     res = solve_on_branch(make_solver("pinocchio", robot), T, q_home_flipped)
     assert branch_of(res.q) == branch_of(q_home_flipped)
     assert branch_of(res.q) != branch_of(q_other)
-
-
-def test_unknown_solver() -> None:
-    with pytest.raises(Ur3HanoiError, match="expected one of"):
-        make_solver("ikfast", load_ur3())
 
 
 @settings(max_examples=60, deadline=None)

@@ -9,18 +9,9 @@ import pinocchio as pin
 import pytest
 
 from ur3hanoi.errors import Ur3HanoiError
-from ur3hanoi.robot.model import (
-    JOINT_NAMES,
-    Q_HOME_LAB,
-    T_BASELINK_BASE,
-    JointLimits,
-    ToolOffset,
-    Ur3Model,
-    dh_fk,
-    load_ur3,
-    urdf_path,
-    urdf_text,
-)
+from ur3hanoi.robot.dh import dh_fk
+from ur3hanoi.robot.model import Q_HOME_LAB, T_BASELINK_BASE, JointLimits, Ur3Model, load_ur3
+from ur3hanoi.robot.urdf import JOINT_NAMES, ToolOffset, urdf_path, urdf_text
 
 LAB_TOOL = ToolOffset("ee_link", (0.059, 0.0535, 0.0), (0.0, math.pi / 2, 0.0))
 
@@ -41,7 +32,7 @@ def test_model_has_ur3_joints_and_frames() -> None:
 
 def test_ur5_urdf_is_rejected(monkeypatch: pytest.MonkeyPatch) -> None:
     ur5 = urdf_path().with_name("ur5_robot.urdf")
-    monkeypatch.setattr("ur3hanoi.robot.model.urdf_path", lambda: ur5)
+    monkeypatch.setattr("ur3hanoi.robot.urdf.urdf_path", lambda: ur5)
     urdf_text.cache_clear()
     try:
         with pytest.raises(Ur3HanoiError, match="link length d1"):
@@ -107,11 +98,3 @@ def test_unknown_frame_error_lists_frames() -> None:
     with pytest.raises(Ur3HanoiError, match="expected one of"):
         load_ur3().fk(np.zeros(6), "flange")
 
-
-def test_batched_dh_fk_equals_single() -> None:
-    rng = np.random.default_rng(3)
-    qs = rng.uniform(-math.pi, math.pi, size=(50, 6))
-    batch = dh_fk(qs)
-    assert batch.shape == (50, 4, 4)
-    for q, T in zip(qs, batch, strict=True):
-        assert np.array_equal(dh_fk(q), T)

@@ -10,10 +10,11 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from ur3hanoi.robot.dh import dh_fk
 from ur3hanoi.robot.ik import analytic_ik, branch_of, wrap_angle
-from ur3hanoi.robot.model import JOINT_NAMES, dh_fk, load_ur3
+from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.robot.registry import UR3, UR3E, RobotDescription
-from ur3hanoi.robot.urdf import link_inertias, urdf_from_dh
+from ur3hanoi.robot.urdf import JOINT_NAMES, link_inertias, urdf_from_dh
 
 
 def _rot_z(t: float) -> np.ndarray:

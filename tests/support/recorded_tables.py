@@ -17,7 +17,8 @@ import numpy as np
 import pinocchio as pin
 import yaml
 
-from ur3hanoi.robot.ik import make_solver, solve_on_branch
+from ur3hanoi.robot.ik import solve_on_branch
+from ur3hanoi.robot.ik_solvers import make_solver
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import ABOVE, ON, T_world_tcp

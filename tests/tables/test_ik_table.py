@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ur3hanoi.errors import TableError
-from ur3hanoi.robot.ik import pose_errors
+from ur3hanoi.robot.ik_solvers import pose_errors
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import T_world_tcp, pose_label

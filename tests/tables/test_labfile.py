@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from tests.conftest import LAB_REAL, LAB_SIM, REPO
 from ur3hanoi.cli import main
 from ur3hanoi.errors import OutputError, TableError
-from ur3hanoi.robot.ik import pose_errors
+from ur3hanoi.robot.ik_solvers import pose_errors
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import T_world_tcp

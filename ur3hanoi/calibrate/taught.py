@@ -33,7 +33,7 @@ from ur3hanoi.errors import TaughtPointsError, printable
 from ur3hanoi.io.schema import Choice, Field, ListOf, Number, Record, Vector
 from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
-from ur3hanoi.robot.model import N_JOINTS
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import MAX_HEIGHTS, MAX_TOWERS
 from ur3hanoi.station.grid import ABOVE, ON, POSE_NAMES, pose_label
 from ur3hanoi.tables import RecordedTable, Slot, read_recorded_table

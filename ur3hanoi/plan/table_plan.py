@@ -39,7 +39,7 @@ from ur3hanoi.plan.checks.limits import check_limits
 from ur3hanoi.plan.motion.ruckig import OfflineRuckig
 from ur3hanoi.plan.motion.sampling import sample
 from ur3hanoi.plan.types import Phase, Plan, PlanConfig, Segment
-from ur3hanoi.robot.model import N_JOINTS
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import ABOVE, ON
 from ur3hanoi.tables.visits import entry_label, require_entries

@@ -18,7 +18,7 @@ from ruckig import Trajectory as RuckigTrajectory
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
 from ur3hanoi.hanoi import Move
-from ur3hanoi.robot.model import N_JOINTS
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import Station
 
 # The via grid at the above poses (see ur3hanoi.plan.motion.legs): path speeds in units of vb = L / T0 and path

@@ -13,7 +13,8 @@ them. Pinocchio stays the reference model of :class:`ur3hanoi.robot.model.Ur3Mod
 numerical IK refiners).
 
 Frames: every placement is in the URDF root link's frame (``base_link`` for the UR URDFs, whose ``world`` link is
-fixed to it at the identity).
+fixed to it at the identity); FK results are in that frame too, or in the frame a chain is given as its ``base``
+(the controller ``base`` of a UR arm, :class:`ur3hanoi.robot.model.Ur3Model`).
 """
 
 from __future__ import annotations
@@ -145,12 +146,14 @@ class UrdfChain:
         axes: each joint's unit axis in its own frame.
         frames: link name -> (index of its parent joint, 0 = the root link, i = ``joint_names[i - 1]``; its
             placement in that joint's frame, 4x4); Pinocchio's ``model.frames[...].placement``.
+        H_base_root: the root link's pose in the frame :meth:`fk` reports poses in (4x4); None: the root's own.
     """
 
     joint_names: tuple[str, ...]
     joint_placements: tuple[FloatArray, ...]
     axes: tuple[FloatArray, ...]
     frames: dict[str, tuple[int, FloatArray]]
+    H_base_root: FloatArray | None = None
     _terms: tuple[FloatArray, FloatArray, FloatArray] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -163,8 +166,13 @@ class UrdfChain:
         object.__setattr__(self, "_terms", (P, P @ K, P @ K @ K))
 
     def fk(self, q: FloatArray, frame: str) -> FloatArray:
-        """4x4 pose of link ``frame`` in the root link's frame at joint angles ``q`` [rad]; ``q`` of shape (N, n)
-        gives (N, 4, 4) (one NumPy pass for a whole table)."""
+        """4x4 pose of link ``frame`` at joint angles ``q`` [rad], in the root link's frame or, when the chain has
+        one, in :attr:`H_base_root`'s base; ``q`` of shape (N, n) gives (N, 4, 4) (one NumPy pass for a whole
+        table)."""
+        T_root_frame = self._fk_root(q, frame)
+        return T_root_frame if self.H_base_root is None else self.H_base_root @ T_root_frame
+
+    def _fk_root(self, q: FloatArray, frame: str) -> FloatArray:
         try:
             parent, placement = self.frames[frame]
         except KeyError:
@@ -182,8 +190,9 @@ class UrdfChain:
         return T @ placement
 
 
-def parse_chain(urdf: str) -> UrdfChain:
-    """The serial chain of ``urdf`` (text): its revolute joints from the root link, every link as a frame.
+def parse_chain(urdf: str, H_base_root: FloatArray | None = None) -> UrdfChain:
+    """The serial chain of ``urdf`` (text): its revolute joints from the root link, every link as a frame; FK in the
+    root link's frame, or in a base frame in which the root link's pose is ``H_base_root`` (4x4).
 
     Raises:
         Ur3HanoiError: the text is not a URDF, has joints of another type than revolute or fixed, or branches
@@ -237,7 +246,7 @@ def parse_chain(urdf: str) -> UrdfChain:
             axes.append(axis)
             stack.append((child, len(names), np.eye(4)))
     # The root link is Pinocchio's universe: a fixed world link moves nothing, so frames stay in the root's frame.
-    return UrdfChain(tuple(names), tuple(placements), tuple(axes), frames)
+    return UrdfChain(tuple(names), tuple(placements), tuple(axes), frames, H_base_root)
 
 
 __all__ = ["UrdfChain", "axis_rotation", "parse_chain", "rigid_inverse", "rpy_matrix", "se3_act_inv", "se3_mul",

@@ -1,47 +1,40 @@
-"""Inverse kinematics of the UR3: closed-form branches, and two numerical solvers behind one interface.
+"""Inverse kinematics of a UR arm: the closed-form branches, and the branch policy tables use.
 
-- :func:`analytic_ik` enumerates the (up to) 8 closed-form solutions of a flange pose from the DH geometry; it
-  names each by its configuration branch (shoulder, elbow, wrist signs).
-- :class:`PinocchioIK` (damped least squares on the SE(3) log error) and :class:`PlacoIK` (placo's
-  ``KinematicsSolver`` with a frame task) refine a seed to machine precision. Both solve for the ``tcp`` frame
-  in the controller ``base`` frame and return an :class:`IKResult` whose errors are measured by FK.
+- :func:`analytic_ik` enumerates the (up to) 8 closed-form solutions of a flange pose from the robot's DH table
+  (:mod:`ur3hanoi.robot.registry`); it names each by its configuration branch (shoulder, elbow, wrist signs).
 - :func:`solve_on_branch` is what tables use: the closed-form solution on home's branch, measured by FK of the
-  URDF model and refined by the numerical solver only when its residual exceeds :data:`POSITION_TOL` /
-  :data:`ORIENTATION_TOL` (the closed form alone is about 1e-12 m accurate on the UR3, and several times
-  faster); then it requires the home branch and the 2pi-equivalent of every joint nearest to home within
-  limits, so moves between waypoints never flip the arm. :func:`solve_table_on_branch` does the same for a whole
-  table with one FK pass.
+  URDF model and refined by a numerical solver (:mod:`ur3hanoi.robot.ik_solvers`) only when its residual exceeds
+  :data:`~ur3hanoi.robot.ik_solvers.POSITION_TOL` / :data:`~ur3hanoi.robot.ik_solvers.ORIENTATION_TOL` (the
+  closed form alone is about 1e-12 m accurate on the UR3, and several times faster); then it requires the home
+  branch and the 2pi-equivalent of every joint nearest to home within limits, so moves between waypoints never
+  flip the arm. :func:`solve_table_on_branch` does the same for a whole table with one FK pass.
 
-Poses are ``pin.SE3`` or 4x4 matrices. The closed form and its FK check use NumPy only (the URDF chain of
-:mod:`ur3hanoi.robot.chain`, Pinocchio's numbers): Pinocchio (and placo) are imported only when a pose needs a
-refinement or an error message names a pose's roll-pitch-yaw.
+Poses are ``pin.SE3`` or 4x4 matrices. The closed form and its FK check use NumPy only (the DH matrices of
+:mod:`ur3hanoi.robot.dh`; the SE(3) products and the URDF chain FK of :mod:`ur3hanoi.robot.chain`, Pinocchio's
+numbers): Pinocchio (and placo) are imported only when a pose needs a refinement or an error message names a
+pose's roll-pitch-yaw.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.errors import IKError, Ur3HanoiError
+from ur3hanoi.errors import IKError
 from ur3hanoi.robot.chain import se3_mul
-from ur3hanoi.robot.model import DH_A, DH_D, JointLimits, Ur3Model, dh_link
-from ur3hanoi.robot.registry import DHParameters
+from ur3hanoi.robot.dh import dh_link
+from ur3hanoi.robot.ik_solvers import CLOSED_FORM, IKResult, IKSolver, as_matrix, closest_reach, pose_errors
+from ur3hanoi.robot.model import JointLimits, Ur3Model
+from ur3hanoi.robot.registry import UR3, DHParameters
 
 if TYPE_CHECKING:
     import pinocchio as pin
 
 Branch = tuple[int, int, int]
-
-POSITION_TOL = 1e-9  # [m] required accuracy of every table pose
-ORIENTATION_TOL = 1e-9  # [rad]
-SOLVERS: tuple[str, ...] = ("pinocchio", "placo")
-CLOSED_FORM = "closed-form"
-"""``IKResult.solver`` of a pose the closed form solved within the tolerances (no refinement)."""
 
 
 def wrap_angle(x: FloatArray | float) -> FloatArray:
@@ -49,38 +42,18 @@ def wrap_angle(x: FloatArray | float) -> FloatArray:
     return (np.asarray(x, dtype=float) + math.pi) % (2 * math.pi) - math.pi
 
 
-def as_matrix(T: pin.SE3 | FloatArray) -> FloatArray:
-    """A pose as a 4x4 homogeneous matrix (a ``pin.SE3`` or a 4x4 array)."""
-    return T.homogeneous if hasattr(T, "homogeneous") else np.asarray(T, dtype=float)
-
-
-def rotation_angle(R: FloatArray) -> float:
-    """Angle [rad] of a rotation matrix (the norm of its log), accurate for tiny angles too: ``atan2`` of the
-    skew part's norm (the sine, to rounding) and ``(trace - 1) / 2`` (the cosine)."""
-    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R.tolist()
-    s = 0.5 * math.sqrt((r21 - r12) ** 2 + (r02 - r20) ** 2 + (r10 - r01) ** 2)
-    return math.atan2(s, 0.5 * (r00 + r11 + r22 - 1.0))
-
-
-def pose_errors(T_actual: pin.SE3 | FloatArray, T_target: pin.SE3 | FloatArray) -> tuple[float, float]:
-    """(position error [m], orientation error [rad]) between two poses (``pin.SE3`` or 4x4 matrices)."""
-    A, B = as_matrix(T_actual), as_matrix(T_target)
-    dp = math.dist(A[:3, 3].tolist(), B[:3, 3].tolist())
-    return dp, rotation_angle(A[:3, :3].T @ B[:3, :3])
-
-
 # ------------------------------------------------------------------------------------------------ branches
 
 
-def _p05(q: FloatArray, dh: DHParameters | None = None) -> FloatArray:
+def _p05(q: FloatArray, dh: DHParameters) -> FloatArray:
     """Origin of DH frame 5 (the wrist point used for the shoulder branch) in base [m]."""
     T06 = dh_link(q[0], 0, dh)  # one configuration: six 4x4 products beat the batched dh_fk's set-up
     for i in range(1, 6):
         T06 = T06 @ dh_link(q[i], i, dh)
-    return T06[:3, 3] - (DH_D if dh is None else dh.d)[5] * T06[:3, 2]
+    return T06[:3, 3] - dh.d[5] * T06[:3, 2]
 
 
-def branch_of(q: FloatArray, dh: DHParameters | None = None) -> Branch:
+def branch_of(q: FloatArray, dh: DHParameters = UR3.dh) -> Branch:
     """Configuration branch of ``q`` [rad] as signs (shoulder, elbow, wrist), each +1 or -1.
 
     shoulder: which of the two base angles that put the wrist point in the arm plane ("left/right");
@@ -100,7 +73,7 @@ BRANCHES: tuple[Branch, ...] = tuple((s, e, w) for s in (1, -1) for e in (1, -1)
 
 
 def analytic_ik(T_base_tool0: pin.SE3 | FloatArray, only: Branch | None = None,
-                dh: DHParameters | None = None) -> dict[Branch, FloatArray]:
+                dh: DHParameters = UR3.dh) -> dict[Branch, FloatArray]:
     """Closed-form UR IK of a flange (``tool0``) pose in ``base``: ``{branch: q}`` for every reachable branch.
 
     Angles are in [-pi, pi). Singular wrist configurations (sin q5 ~ 0) are skipped. ``only`` restricts the
@@ -115,7 +88,7 @@ def analytic_ik(T_base_tool0: pin.SE3 | FloatArray, only: Branch | None = None,
     """
     T = as_matrix(T_base_tool0)
     (xx, yx, zx, px), (xy, yy, zy, py), (xz, yz, zz, pz) = T[:3].tolist()
-    D, A = (DH_D, DH_A) if dh is None else (dh.d, dh.a)
+    D, A = dh.d, dh.a
     d1, d4, d5, d6 = D[0], D[3], D[4], D[5]
     a2, a3 = A[1], A[2]
     wx, wy = px - d6 * zx, py - d6 * zy  # wrist point p05 (its z is not needed)
@@ -175,167 +148,16 @@ def nearest_equivalent(q: FloatArray, q_ref: FloatArray, limits: JointLimits) ->
     return np.array(out)
 
 
-# ------------------------------------------------------------------------------------------------- solvers
-
-
-@dataclass(frozen=True)
-class IKResult:
-    """Outcome of one IK solve. ``q`` [rad]; errors measured by FK of the ``tcp`` frame (the URDF model's).
-
-    ``solver`` is :data:`CLOSED_FORM` (``iterations`` 0) when the closed form was accurate enough, else the name
-    of the numerical solver that refined it.
-    """
-
-    q: FloatArray
-    position_error: float  # [m]
-    orientation_error: float  # [rad]
-    iterations: int
-    solver: str
-
-    @property
-    def converged(self) -> bool:
-        return self.position_error <= POSITION_TOL and self.orientation_error <= ORIENTATION_TOL
-
-
-class IKSolver(Protocol):
-    """Numerical IK of the ``tcp`` frame; targets are ``T_base_tcp`` poses in the controller ``base`` frame."""
-
-    name: str
-    robot: Ur3Model
-
-    def solve(self, T_base_tcp: pin.SE3 | FloatArray, q_seed: FloatArray) -> IKResult: ...
-
-
-class PinocchioIK:
-    """Damped least squares on the SE(3) log error (full Newton steps with ``Jlog6``).
-
-    Args:
-        robot: model with the station's ``tcp`` frame.
-        max_iterations: iteration cap (converged solves take 3-6).
-        damping: Tikhonov damping of J J^T [-]; tiny so the last steps stay quadratic.
-        stop_tol: stop once the log error norm is below this (well under the 1e-9 acceptance).
-    """
-
-    name = "pinocchio"
-
-    def __init__(self, robot: Ur3Model, max_iterations: int = 100, damping: float = 1e-12,
-                 stop_tol: float = 1e-13) -> None:
-        self.robot = robot
-        self.max_iterations = max_iterations
-        self.damping = damping
-        self.stop_tol = stop_tol
-        self._damping_eye = damping * np.eye(6)
-
-    def solve(self, T_base_tcp: pin.SE3 | FloatArray, q_seed: FloatArray) -> IKResult:
-        import pinocchio as pin
-
-        from ur3hanoi.robot.model import T_BASELINK_BASE
-
-        model, data = self.robot.model, self.robot.data
-        fid = self.robot.frame_ids["tcp"]
-        # Work in the URDF root frame (base_link) where Pinocchio's oMf lives.
-        target = T_BASELINK_BASE * pin.SE3(as_matrix(T_base_tcp))
-        q = np.array(q_seed, dtype=float)
-        it = 0
-        for it in range(1, self.max_iterations + 1):
-            pin.forwardKinematics(model, data, q)
-            iMd = pin.updateFramePlacement(model, data, fid).actInv(target)
-            err = pin.log6(iMd).vector
-            if math.sqrt(err @ err) < self.stop_tol:
-                break
-            J = pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL)
-            J = -pin.Jlog6(iMd.inverse()) @ J
-            dq = -J.T @ np.linalg.solve(J @ J.T + self._damping_eye, err)
-            # Cap the step: far from the solution a full Gauss-Newton step can leap across branches.
-            step = float(np.max(np.abs(dq)))
-            if step > 0.5:
-                dq *= 0.5 / step
-            q = q + dq
-        else:
-            pin.forwardKinematics(model, data, q)
-            iMd = pin.updateFramePlacement(model, data, fid).actInv(target)
-        # iMd is the target seen from the reached TCP: its translation norm is the position error.
-        dp = float(np.linalg.norm(iMd.translation))
-        dr = float(np.linalg.norm(pin.log3(iMd.rotation)))
-        return IKResult(q=q, position_error=dp, orientation_error=dr, iterations=it, solver=self.name)
-
-
-class PlacoIK:
-    """placo ``KinematicsSolver`` with one hard-ish frame task on ``tcp`` (floating base masked).
-
-    placo cannot resolve ``package://`` URIs, so it is given the URDF text with absolute mesh paths.
-    """
-
-    name = "placo"
-
-    def __init__(self, robot: Ur3Model, max_iterations: int = 50, stop_tol: float = 1e-13) -> None:
-        self.robot = robot
-        self.max_iterations = max_iterations
-        self.stop_tol = stop_tol
-        self._built = False  # placo and its model are loaded on the first solve: a table rarely needs any
-
-    def _build(self) -> None:
-        import placo  # imported here: placo is heavy and only this solver needs it
-
-        self._names = list(self.robot.model.names[1:])
-        self._robot = placo.RobotWrapper("", placo.Flags.ignore_collisions, self.robot.urdf)
-        self._solver = placo.KinematicsSolver(self._robot)
-        self._solver.mask_fbase(True)
-        self._solver.enable_joint_limits(False)  # limits are enforced by solve_on_branch, on the 2pi-shift
-        self._solver.enable_velocity_limits(False)
-        self._task = self._solver.add_frame_task("tcp", np.eye(4))
-        self._task.configure("tcp", "soft", 1.0, 1.0)
-        self._built = True
-
-    def solve(self, T_base_tcp: pin.SE3 | FloatArray, q_seed: FloatArray) -> IKResult:
-        import pinocchio as pin
-
-        from ur3hanoi.robot.model import T_BASELINK_BASE
-
-        if not self._built:
-            self._build()
-        T_base_tcp = pin.SE3(as_matrix(T_base_tcp))
-        target = (T_BASELINK_BASE * T_base_tcp).homogeneous
-        self._task.T_world_frame = target
-        for name, v in zip(self._names, np.asarray(q_seed, dtype=float), strict=True):
-            self._robot.set_joint(name, float(v))
-        self._robot.update_kinematics()
-        it = 0
-        for it in range(1, self.max_iterations + 1):
-            self._solver.solve(True)
-            self._robot.update_kinematics()
-            T = self._robot.get_T_world_frame("tcp")
-            if np.linalg.norm(pin.log6(pin.SE3(T).actInv(pin.SE3(target))).vector) < self.stop_tol:
-                break
-        q = np.array([self._robot.get_joint(n) for n in self._names])
-        dp, dr = pose_errors(self.robot.fk(q, "tcp"), T_base_tcp)
-        return IKResult(q=q, position_error=dp, orientation_error=dr, iterations=it, solver=self.name)
-
-
-def make_solver(name: str, robot: Ur3Model) -> IKSolver:
-    """The solver called ``name`` (one of :data:`SOLVERS`) for ``robot``."""
-    if name == "pinocchio":
-        return PinocchioIK(robot)
-    if name == "placo":
-        return PlacoIK(robot)
-    raise Ur3HanoiError(f"IK solver {name!r} is unknown: expected one of {SOLVERS}")
+# ------------------------------------------------------------------------------------------ branch policy
 
 
 def closed_form_result(robot: Ur3Model, T_base_tcp: pin.SE3 | FloatArray, q: FloatArray) -> IKResult:
     """A closed-form solution ``q`` [rad] of ``T_base_tcp`` as an :class:`IKResult`, its errors measured by FK
     of the URDF model (which the DH geometry of :func:`analytic_ik` matches to about 1e-12 m on the UR3): the NumPy
-    FK of its chain (:meth:`~ur3hanoi.robot.model.Ur3Model.fk_matrix`, Pinocchio's FK to rounding), so a table that
-    needs no refinement needs no Pinocchio."""
-    dp, dr = pose_errors(robot.fk_matrix(q, "tcp"), T_base_tcp)
+    FK of its chain in ``base`` (:meth:`ur3hanoi.robot.chain.UrdfChain.fk`, Pinocchio's FK to rounding), so a table
+    that needs no refinement needs no Pinocchio."""
+    dp, dr = pose_errors(robot.chain.fk(q, "tcp"), T_base_tcp)
     return IKResult(q=q, position_error=dp, orientation_error=dr, iterations=0, solver=CLOSED_FORM)
-
-
-def closest_reach(robot: Ur3Model, T_base_tcp: pin.SE3 | FloatArray, q_seed: FloatArray) -> IKResult:
-    """Heavily damped least squares from ``q_seed``: the pose closest to an unreachable target, for its residual.
-
-    Damping keeps the steps bounded at the workspace boundary, where the Jacobian is singular.
-    """
-    return PinocchioIK(robot, max_iterations=300, damping=1e-3).solve(T_base_tcp, q_seed)
 
 
 def solve_on_branch(solver: IKSolver, T_base_tcp: pin.SE3 | FloatArray, q_home: FloatArray, label: str = "pose",
@@ -418,7 +240,7 @@ def solve_table_on_branch(solver: IKSolver, targets: Sequence[pin.SE3 | FloatArr
         branches = analytic_ik(se3_mul(H_base_tcp, robot.H_tcp_tool0), only=home_branch, dh=robot.dh)
         seeds.append(nearest_equivalent(branches[home_branch], q_home, robot.limits) if branches else None)
     ok = [i for i, q in enumerate(seeds) if q is not None]
-    reached = robot.fk_matrix(np.array([seeds[i] for i in ok]).reshape(-1, 6), "tcp")
+    reached = robot.chain.fk(np.array([seeds[i] for i in ok]).reshape(-1, 6), "tcp")
     results: dict[int, IKResult] = {}
     for i, H_reached in zip(ok, reached, strict=True):
         dp, dr = pose_errors(H_reached, H[i])
@@ -428,3 +250,16 @@ def solve_table_on_branch(solver: IKSolver, targets: Sequence[pin.SE3 | FloatArr
             results[i] = res
     return [results[i] if i in results else solve_on_branch(solver, targets[i], q_home, labels[i], home_branch)
             for i in range(len(H))]
+
+
+__all__ = [
+    "BRANCHES",
+    "Branch",
+    "analytic_ik",
+    "branch_of",
+    "closed_form_result",
+    "nearest_equivalent",
+    "solve_on_branch",
+    "solve_table_on_branch",
+    "wrap_angle",
+]

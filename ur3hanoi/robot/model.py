@@ -1,4 +1,4 @@
-"""The UR3 (CB3) model: URDF location, DH parameters, datasheet limits, and Pinocchio forward kinematics.
+"""The UR3 (CB3) model and the other registered arms: frames, datasheet limits, and forward kinematics.
 
 Frames (all right-handed, metres):
 
@@ -16,10 +16,8 @@ drives both; only the root frame differs.
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 from functools import cache, cached_property
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -27,27 +25,13 @@ import numpy as np
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
 from ur3hanoi.robot.chain import UrdfChain, parse_chain, rigid_inverse, se3_act_inv
-from ur3hanoi.robot.registry import CB3_CONTROL_PERIOD_S, UR3, DHParameters, RobotDescription
+from ur3hanoi.robot.registry import CB3_CONTROL_PERIOD_S, N_JOINTS, UR3, DHParameters, RobotDescription
+from ur3hanoi.robot.urdf import FLANGE_FRAMES, JOINT_NAMES, ToolOffset, package_dir, urdf_path, urdf_text
 
 if TYPE_CHECKING:
     import pinocchio as pin
 
     T_BASELINK_BASE: pin.SE3
-
-JOINT_NAMES: tuple[str, ...] = (
-    "shoulder_pan_joint",
-    "shoulder_lift_joint",
-    "elbow_joint",
-    "wrist_1_joint",
-    "wrist_2_joint",
-    "wrist_3_joint",
-)
-N_JOINTS = 6
-
-# UR3 (CB3) DH parameters [m, rad], from Universal Robots' published DH table.
-DH_D: tuple[float, ...] = (0.1519, 0.0, 0.0, 0.11235, 0.08535, 0.0819)
-DH_A: tuple[float, ...] = (0.0, -0.24365, -0.21325, 0.0, 0.0, 0.0)
-DH_ALPHA: tuple[float, ...] = (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0)
 
 # Controller `base` seen from URDF `base_link`: a half turn about z (as a 4x4 matrix; T_BASELINK_BASE is the same
 # as a pin.SE3, made on first use so that importing this module does not import Pinocchio).
@@ -137,146 +121,6 @@ class JointLimits:
         return bool(np.all(q >= np.asarray(self.q_min) - tol) and np.all(q <= np.asarray(self.q_max) + tol))
 
 
-@dataclass(frozen=True)
-class ToolOffset:
-    """The suction point (TCP) as a fixed offset from a flange frame.
-
-    Attributes:
-        parent: ``"ee_link"`` (x along the tool axis, the course URDF's convention) or ``"tool0"`` (z along it).
-        xyz: translation [m] in the parent frame.
-        rpy: URDF roll-pitch-yaw [rad] (fixed axes x, y, z) of the TCP frame in the parent frame.
-    """
-
-    parent: str = "ee_link"
-    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
-
-
-FLANGE_FRAMES: tuple[str, ...] = ("ee_link", "tool0")
-
-
-@cache
-def _erd_share_dir() -> Path:
-    """`cmeel.prefix/share` of the installed example-robot-data, found without importing its loaders.
-
-    The folder of its ``example_robot_data-*.dist-info`` on ``sys.path`` (what ``importlib.metadata`` finds, without
-    the cost of importing it); ``importlib.metadata`` when there is no such folder (another kind of install).
-    """
-    import os
-    import sys
-
-    for entry in sys.path:
-        try:
-            names = os.listdir(entry or ".")
-        except OSError:
-            continue
-        if any(n.startswith("example_robot_data-") and n.endswith(".dist-info") for n in names):
-            return Path(entry or ".").resolve() / "cmeel.prefix" / "share"
-    import importlib.metadata
-
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError as exc:
-        raise Ur3HanoiError(
-            "example-robot-data is not installed: run `make venv` (it installs requirements.lock)"
-        ) from exc
-    return Path(str(dist.locate_file("cmeel.prefix/share")))
-
-
-def urdf_path(robot: RobotDescription = UR3) -> Path:
-    """Path of example-robot-data's ``ur3_robot.urdf`` (loaded by path: some loaders map "ur3" to a UR5), or of
-    ``robot``'s URDF file there."""
-    path = _erd_share_dir() / f"example-robot-data/robots/ur_description/urdf/{robot.urdf_file}"
-    if not path.is_file():
-        raise Ur3HanoiError(f"UR3 URDF not found at {path}: example-robot-data >= 4.4 is required")
-    return path
-
-
-def package_dir() -> Path:
-    """Directory that resolves the URDF's ``package://example-robot-data/...`` mesh URIs."""
-    return _erd_share_dir()
-
-
-def _fmt(x: float) -> str:
-    return repr(float(x))
-
-
-@cache
-def urdf_text(tool: ToolOffset | None = None, absolute_meshes: bool = True, robot: RobotDescription = UR3) -> str:
-    """The UR3 URDF (or ``robot``'s) as text, optionally with a ``tcp`` link fixed to ``tool.parent``.
-
-    ``absolute_meshes`` rewrites ``package://`` URIs to absolute paths (placo and MuJoCo cannot resolve them).
-    A robot described by DH only (``model_source == "dh"``) gets the URDF :mod:`ur3hanoi.robot.urdf` generates.
-    """
-    if robot.model_source == "dh":
-        from ur3hanoi.robot.urdf import urdf_from_dh
-
-        text = urdf_from_dh(robot)
-    else:
-        text = (urdf_path() if robot == UR3 else urdf_path(robot)).read_text()
-    if absolute_meshes:
-        text = text.replace("package://", str(package_dir()) + "/")
-    if tool is not None:
-        if tool.parent not in FLANGE_FRAMES:
-            raise Ur3HanoiError(f"tool parent frame {tool.parent!r} is invalid: expected one of {FLANGE_FRAMES}")
-        xyz = " ".join(_fmt(v) for v in tool.xyz)
-        rpy = " ".join(_fmt(v) for v in tool.rpy)
-        tcp = (
-            '  <link name="tcp"/>\n'
-            '  <joint name="tcp_fixed_joint" type="fixed">\n'
-            f'    <parent link="{tool.parent}"/>\n    <child link="tcp"/>\n'
-            f'    <origin xyz="{xyz}" rpy="{rpy}"/>\n  </joint>\n'
-        )
-        text = re.sub(r"</robot>\s*$", tcp + "</robot>\n", text)
-    return text
-
-
-def dh_link(theta: float, i: int, dh: DHParameters | None = None) -> FloatArray:
-    """4x4 DH transform of joint ``i`` (0-based) at angle ``theta`` [rad]: Rz(theta) Tz(d) Tx(a) Rx(alpha).
-
-    Scalar form for the closed-form IK's hot path; :func:`dh_fk` builds the same matrices vectorized. ``dh``: the
-    robot's table (default the UR3's).
-    """
-    DH_D, DH_A, DH_ALPHA = _table(dh)
-    ct, st = math.cos(theta), math.sin(theta)
-    ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
-    return np.array(
-        [[ct, -st * ca, st * sa, DH_A[i] * ct], [st, ct * ca, -ct * sa, DH_A[i] * st], [0.0, sa, ca, DH_D[i]],
-         [0.0, 0.0, 0.0, 1.0]]
-    )
-
-
-def _table(dh: DHParameters | None) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
-    """(d, a, alpha) of ``dh``, or the UR3's module constants."""
-    return (DH_D, DH_A, DH_ALPHA) if dh is None else (dh.d, dh.a, dh.alpha)
-
-
-def dh_fk(q: FloatArray, dh: DHParameters | None = None) -> FloatArray:
-    """UR3 (or ``dh``'s robot) forward kinematics from the DH table: the pose of the flange (``tool0``) in ``base``.
-
-    ``q`` [rad] of shape (6,) gives a 4x4 matrix; shape (N, 6) gives (N, 4, 4) (batched, for checks over whole
-    trajectories without a per-sample Pinocchio call).
-    """
-    DH_D, DH_A, DH_ALPHA = _table(dh)
-    q = np.asarray(q, dtype=float)
-    qs = q.reshape(-1, N_JOINTS)
-    T = np.broadcast_to(np.eye(4), (len(qs), 4, 4))
-    for i in range(N_JOINTS):
-        ct, st = np.cos(qs[:, i]), np.sin(qs[:, i])
-        ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
-        A = np.zeros((len(qs), 4, 4))
-        A[:, 0, 0], A[:, 0, 1], A[:, 0, 2], A[:, 0, 3] = ct, -st * ca, st * sa, DH_A[i] * ct
-        A[:, 1, 0], A[:, 1, 1], A[:, 1, 2], A[:, 1, 3] = st, ct * ca, -ct * sa, DH_A[i] * st
-        A[:, 2, 1], A[:, 2, 2], A[:, 2, 3] = sa, ca, DH_D[i]
-        A[:, 3, 3] = 1.0
-        T = T @ A
-    return T[0] if q.ndim == 1 else T
-
-
-# Link lengths the URDF must encode [m]; a UR5 (d1 = 0.089159, a2 = 0.425) fails this check.
-_EXPECTED_LENGTHS = {"d1": 0.1519, "a2": 0.24365, "a3": 0.21325, "d4": 0.11235, "d5": 0.08535, "d6": 0.0819}
-
-
 def _link_lengths(chain: UrdfChain) -> dict[str, float]:
     def p(name: str) -> FloatArray:
         return chain.joint_placements[chain.joint_names.index(name)][:3, 3]
@@ -309,13 +153,13 @@ class Ur3Model:
         self.description = robot
         self.dh: DHParameters = robot.dh
         self.urdf = urdf_text(self.tool, absolute_meshes=True, robot=robot)
-        self.chain = parse_chain(self.urdf)
+        self.chain = parse_chain(self.urdf, H_BASE_BASELINK)
         if self.chain.joint_names != JOINT_NAMES:
             raise Ur3HanoiError(f"URDF joints {self.chain.joint_names} are not the UR3's {JOINT_NAMES}")
         lengths = _link_lengths(self.chain)
         d, a = robot.dh.d, robot.dh.a
-        expected_lengths = _EXPECTED_LENGTHS if robot is UR3 else {
-            "d1": d[0], "a2": -a[1], "a3": -a[2], "d4": d[3], "d5": d[4], "d6": d[5]}
+        # The URDF must encode the registry's DH lengths: a UR5's URDF (d1 = 0.089159 m) fails here.
+        expected_lengths = {"d1": d[0], "a2": -a[1], "a3": -a[2], "d4": d[3], "d5": d[4], "d6": d[5]}
         for key, expected in expected_lengths.items():
             if abs(lengths[key] - expected) > 1e-6:
                 raise Ur3HanoiError(
@@ -376,11 +220,12 @@ class Ur3Model:
 
     def fk_matrix(self, q: FloatArray, frame: str = "tcp") -> FloatArray:
         """4x4 pose of ``frame`` in the controller ``base`` frame at ``q`` [rad] ((N, 4, 4) for ``q`` of shape
-        (N, 6)): the NumPy FK of the URDF chain, equal to :meth:`fk` to rounding (no Pinocchio)."""
+        (N, 6)): the NumPy FK of the URDF chain (:attr:`chain`, whose base is the controller's), equal to :meth:`fk`
+        to rounding (no Pinocchio)."""
         if frame not in ("base", "base_link", "tool0", "tcp", "ee_link"):
             raise Ur3HanoiError(f"frame {frame!r} is unknown: expected one of "
                                 f"{sorted(('base', 'base_link', 'tool0', 'tcp', 'ee_link'))}")
-        return H_BASE_BASELINK @ self.chain.fk(q, frame)
+        return self.chain.fk(q, frame)
 
     def frame_jacobian_local(self, q: FloatArray, frame: str = "tcp") -> FloatArray:
         """6x6 Jacobian of ``frame`` in its own (LOCAL) frame; frame-independent of the root rotation."""
@@ -414,11 +259,9 @@ def load_ur3(tool: ToolOffset | None = None, limits: JointLimits | None = None,
     return Ur3Model(tool, limits, robot)
 
 
+# JOINT_NAMES, ToolOffset, package_dir, urdf_path (homes: ur3hanoi.robot.urdf) and N_JOINTS (ur3hanoi.robot.registry)
+# are listed here too while sim/ and interface/ still import them from this module (issue 27).
 __all__ = [
-    "DH_A",
-    "DH_ALPHA",
-    "DH_D",
-    "FLANGE_FRAMES",
     "H_BASELINK_BASE",
     "H_BASE_BASELINK",
     "JOINT_NAMES",
@@ -428,10 +271,7 @@ __all__ = [
     "JointLimits",
     "ToolOffset",
     "Ur3Model",
-    "dh_fk",
-    "dh_link",
     "load_ur3",
     "package_dir",
     "urdf_path",
-    "urdf_text",
 ]

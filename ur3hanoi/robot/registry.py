@@ -1,5 +1,9 @@
 """The robots ur3hanoi knows: one frozen :class:`RobotDescription` per arm, looked up by name.
 
+This module is the one home of each robot's numbers: its DH table (link lengths and twists) is written here and
+nowhere else in the package; the URDF check, the DH matrices (:mod:`ur3hanoi.robot.dh`), the closed-form IK, the
+generated URDF and the MuJoCo model all read it (tests/robot/test_registry.py greps the source for a second copy).
+
 A calibration names its robot (``robot.model: ur3e``; ``ur3`` when absent) and everything robot-specific is read
 from its description: the DH table (kinematics, closed-form IK), the datasheet limits, where its URDF and MuJoCo
 model come from, and the published dynamics of arms that have no URDF here. Nothing else in the package branches
@@ -10,11 +14,10 @@ Sources:
 - ``ur3`` (CB3): DH, speed limits and torques from Universal Robots' published DH table and the UR3 datasheet;
   URDF and meshes from example-robot-data's ``ur3_robot.urdf``; MuJoCo model ``robots/universal_robots_ur3``.
 - ``ur3e`` (e-Series): DH from Universal Robots' published table ("DH parameters for calculations of kinematics
-  and dynamics": d1 = 0.15185, a2 = -0.24355, a3 = -0.2132, d4 = 0.13105, d5 = 0.08535, d6 = 0.0921 m, as in
-  ``../shared/lab/ros2-interface.md``), link masses and centres of mass (in the DH link frames) from the same
-  page; speeds 180 / 360 deg/s and the 56 / 28 / 12 N m joint torques (size 2 base and shoulder, size 1 elbow,
-  size 0 wrists) from the UR3e datasheet. There is no UR3e URDF in example-robot-data: its URDF and MuJoCo model
-  are generated from this description with primitive shapes (:mod:`ur3hanoi.robot.urdf`,
+  and dynamics", the same numbers as ``../shared/lab/ros2-interface.md``), link masses and centres of mass (in the
+  DH link frames) from the same page; speeds 180 / 360 deg/s and the 56 / 28 / 12 N m joint torques (size 2 base
+  and shoulder, size 1 elbow, size 0 wrists) from the UR3e datasheet. There is no UR3e URDF in example-robot-data:
+  its URDF and MuJoCo model are generated from this description with primitive shapes (:mod:`ur3hanoi.robot.urdf`,
   :mod:`ur3hanoi.sim.dh_model`).
 """
 
@@ -26,6 +29,7 @@ from typing import Literal
 
 Vec3 = tuple[float, float, float]
 N_JOINTS = 6
+"""Joints of every registered arm (6R)."""
 
 
 @dataclass(frozen=True)

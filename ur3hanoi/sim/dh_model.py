@@ -4,9 +4,10 @@
 (bodies ``base_link`` .. ``wrist_3_link``, ``ee_link`` with the ``suction_cup`` body and ``suction`` site,
 ``tool0``; joints ``shoulder_pan_joint`` ..; position actuators ``shoulder_pan`` ..; the ``floor`` plane and a
 light as in ``scene.xml``), so the task scene (:mod:`ur3hanoi.sim.scene`) edits either model the same way. Link
-placements are the UR URDF layout of the robot's DH table (:func:`ur3hanoi.robot.urdf.ur_layout`); the visual and
-collision shapes are the primitive cylinders of :func:`ur3hanoi.robot.urdf.link_shapes` (in the e-Series' blue
-and grey, so it is never mistaken for the UR3's meshes), and the masses, centres of mass and inertias are
+placements are the UR URDF layout of the robot's DH table (:func:`ur3hanoi.robot.urdf.ur_layout` and
+:func:`~ur3hanoi.robot.urdf.fixed_frames`, which the generated URDF uses too); the visual and collision shapes are
+the primitive cylinders of :func:`ur3hanoi.robot.urdf.link_shapes` (in the e-Series' blue and grey, so it is never
+mistaken for the UR3's meshes), and the masses, centres of mass and inertias are
 :func:`ur3hanoi.robot.urdf.link_inertias` (UR's published dynamics parameters). Drives: the UR3 model's gains and
 armature (:data:`ur3hanoi.sim.model.DRIVES`) with the robot's datasheet torque limits.
 
@@ -23,9 +24,9 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 
-from ur3hanoi.robot.model import JOINT_NAMES, Q_HOME_LAB
+from ur3hanoi.robot.model import Q_HOME_LAB
 from ur3hanoi.robot.registry import RobotDescription
-from ur3hanoi.robot.urdf import LINKS, link_inertias, link_shapes, ur_layout
+from ur3hanoi.robot.urdf import JOINT_NAMES, LINKS, fixed_frames, link_inertias, link_shapes, ur_layout
 from ur3hanoi.sim.model import DEFAULT_TOOL, DRIVES, T_ee_tcp, cup_geometry, quat_wxyz
 
 _LINK_RGBA = {  # e-Series: blue joint caps, grey tubes
@@ -86,9 +87,9 @@ def build_dh_robot_spec(robot: RobotDescription) -> mujoco.MjSpec:
         act.forcerange = [-robot.torque[i], robot.torque[i]]
         parent = body
 
-    d6 = robot.dh.d[5]
-    ee = parent.add_body(name="ee_link", pos=[0.0, d6, 0.0],
-                         quat=list(quat_wxyz(pin.rpy.rpyToMatrix(0.0, 0.0, math.pi / 2))))
+    fixed = {f.child: f for f in fixed_frames(robot)}
+    ee = parent.add_body(name="ee_link", pos=list(fixed["ee_link"].xyz),
+                         quat=list(quat_wxyz(pin.rpy.rpyToMatrix(*fixed["ee_link"].rpy))))
     T = T_ee_tcp(DEFAULT_TOOL)
     cup = cup_geometry(T)
     cup_body = ee.add_body(name="suction_cup")
@@ -98,8 +99,8 @@ def build_dh_robot_spec(robot: RobotDescription) -> mujoco.MjSpec:
                           conaffinity=0, mass=0.0, rgba=[0.15, 0.15, 0.15, 1.0], group=2)
     cup_body.add_site(name="suction", pos=list(T.translation), quat=list(quat_wxyz(T.rotation)), size=[0.004, 0, 0],
                       rgba=[1, 0, 0, 1], group=4)
-    parent.add_body(name="tool0", pos=[0.0, d6, 0.0],
-                    quat=list(quat_wxyz(pin.rpy.rpyToMatrix(-math.pi / 2, 0.0, 0.0))))
+    parent.add_body(name="tool0", pos=list(fixed["tool0"].xyz),
+                    quat=list(quat_wxyz(pin.rpy.rpyToMatrix(*fixed["tool0"].rpy))))
     spec.add_exclude(bodyname1=LINKS[0], bodyname2=LINKS[1])
     spec.add_key(name="home", qpos=list(Q_HOME_LAB), ctrl=list(Q_HOME_LAB))
     assert tuple(j.name for j in spec.joints) == JOINT_NAMES

@@ -48,17 +48,16 @@ from ur3hanoi.io.schema import Choice, Field, ListOf, Number, Record, Text, Vect
 from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
 from ur3hanoi.robot.chain import rpy_matrix
-from ur3hanoi.robot.model import FLANGE_FRAMES, N_JOINTS, JointLimits, ToolOffset
-from ur3hanoi.robot.registry import DEFAULT_ROBOT, ROBOTS, RobotDescription
+from ur3hanoi.robot.model import JointLimits
+from ur3hanoi.robot.registry import DEFAULT_ROBOT, N_JOINTS, ROBOTS, RobotDescription
+from ur3hanoi.robot.urdf import FLANGE_FRAMES, ToolOffset
 from ur3hanoi.station.suction_profile import (
-    AIN_RANGE_V,
     DEFAULT_PROFILE,
-    DIGIN_MAX,
-    LEVEL_KEYS,
-    MAX_NOISE_V,
     PROFILES,
+    SUCTION_SECTION,
     SuctionProfile,
-    with_levels,
+    parse_suction,
+    suction_section,
 )
 
 if TYPE_CHECKING:
@@ -207,14 +206,7 @@ STATION_SCHEMA = Record({
         "height_step": Field(_POINT),
         "approach": Field(Number(0.0, 0.5, lo_open=True, unit=_M, what="a length")),
     })),
-    "suction": Field(Record({
-        "profile": Field(Choice(tuple(PROFILES)), required=False),
-        **{key: Field(Number(0, DIGIN_MAX, integer=True), required=False) for key in LEVEL_KEYS
-           if key.startswith("digin")},
-        **{key: Field(Number(*AIN_RANGE_V, unit="V", what="a voltage"), required=False) for key in LEVEL_KEYS
-           if key.startswith("ain0") and key != "ain0_noise"},
-        "ain0_noise": Field(Number(0.0, MAX_NOISE_V, unit="V", what="a standard deviation"), required=False),
-    }), required=False),
+    "suction": Field(SUCTION_SECTION, required=False),
 })
 """The calibration file's schema: every key, its type and range (see ``ur3hanoi/station/shipped/README.md``)."""
 
@@ -324,15 +316,6 @@ def with_suction_profile(station: Station, name: str) -> Station:
     return replace(station, suction=PROFILES[name])
 
 
-def parse_suction(section: Mapping[str, Any] | None) -> SuctionProfile:
-    """The suction profile of a (schema-checked) ``suction`` section: a named profile (default ``lab_sim``)
-    with any explicitly given levels replacing its own (the result is then named ``custom``)."""
-    if section is None:
-        return DEFAULT_PROFILE
-    base = PROFILES[section["profile"]] if "profile" in section else DEFAULT_PROFILE
-    return with_levels(base, {k: v for k, v in section.items() if k != "profile"})
-
-
 def validate(s: Station) -> None:
     """Cross-field checks: limits, grid geometry per layout, block overlaps. Raises CalibrationError."""
     fail = CalibrationError.invalid
@@ -394,12 +377,5 @@ def station_to_dict(s: Station) -> dict[str, Any]:
             "height_step": rnd(s.height_step),
             "approach": round(s.approach, 12),
         },
-        "suction": _suction_to_dict(s.suction),
+        "suction": suction_section(s.suction),
     }
-
-
-def _suction_to_dict(p: SuctionProfile) -> dict[str, Any]:
-    """A named profile by its name; a custom one as every level over the default profile."""
-    if PROFILES.get(p.name) == p:
-        return {"profile": p.name}
-    return {k: v for k, v in p.as_dict().items() if k != "profile"}

@@ -23,8 +23,11 @@ model (:mod:`ur3hanoi.sim.suction`) reads it.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
+
+from ur3hanoi.io.schema import Choice, Field, Number, Record
 
 AIN_RANGE_V: tuple[float, float] = (0.0, 10.0)
 """The UR controller's analog inputs read 0..10 V."""
@@ -103,6 +106,34 @@ def with_levels(base: SuctionProfile, levels: dict[str, Any]) -> SuctionProfile:
     return out if out == base else replace(out, name=CUSTOM)
 
 
+SUCTION_SECTION = Record({
+    "profile": Field(Choice(tuple(PROFILES)), required=False),
+    **{key: Field(Number(0, DIGIN_MAX, integer=True), required=False) for key in LEVEL_KEYS
+       if key.startswith("digin")},
+    **{key: Field(Number(*AIN_RANGE_V, unit="V", what="a voltage"), required=False) for key in LEVEL_KEYS
+       if key.startswith("ain0") and key != "ain0_noise"},
+    "ain0_noise": Field(Number(0.0, MAX_NOISE_V, unit="V", what="a standard deviation"), required=False),
+})
+"""The schema of a calibration file's ``suction:`` section (a part of ``STATION_SCHEMA``)."""
+
+
+def parse_suction(section: Mapping[str, Any] | None) -> SuctionProfile:
+    """The suction profile of a (schema-checked) ``suction`` section: a named profile (default ``lab_sim``)
+    with any explicitly given levels replacing its own (the result is then named ``custom``)."""
+    if section is None:
+        return DEFAULT_PROFILE
+    base = PROFILES[section["profile"]] if "profile" in section else DEFAULT_PROFILE
+    return with_levels(base, {k: v for k, v in section.items() if k != "profile"})
+
+
+def suction_section(p: SuctionProfile) -> dict[str, Any]:
+    """``p`` as a calibration file's ``suction:`` section: a named profile by its name; a custom one as every
+    level over the default profile."""
+    if PROFILES.get(p.name) == p:
+        return {"profile": p.name}
+    return {k: v for k, v in p.as_dict().items() if k != "profile"}
+
+
 __all__ = [
     "AIN_RANGE_V",
     "CUSTOM",
@@ -113,7 +144,10 @@ __all__ = [
     "MAX_NOISE_V",
     "PROFILES",
     "REAL",
+    "SUCTION_SECTION",
     "SuctionProfile",
+    "parse_suction",
     "profile_named",
+    "suction_section",
     "with_levels",
 ]

@@ -16,8 +16,10 @@ import numpy as np
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import TableError, printable
 from ur3hanoi.robot.chain import se3_act_inv
-from ur3hanoi.robot.ik import IKResult, IKSolver, branch_of, make_solver, pose_errors, solve_table_on_branch
-from ur3hanoi.robot.model import N_JOINTS, load_ur3
+from ur3hanoi.robot.ik import branch_of, solve_table_on_branch
+from ur3hanoi.robot.ik_solvers import IKResult, IKSolver, make_solver, pose_errors
+from ur3hanoi.robot.model import load_ur3
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import H_world_tcp, T_world_tcp, pose_label
 

@@ -20,7 +20,7 @@ from ur3hanoi.errors import TableError, printable
 from ur3hanoi.hanoi import solve_hanoi, validate_instance
 from ur3hanoi.io.schema import Field, ListOf, Nullable, Number, Record, Spec, Vector, suggest
 from ur3hanoi.io.schema import validate as validate_schema
-from ur3hanoi.robot.model import N_JOINTS
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import MAX_HEIGHTS, MAX_TOWERS
 from ur3hanoi.station.grid import pose_label
 from ur3hanoi.tables.file import BLOCK_XY_KEY, TABLE_KEYS, WHAT, LabFile, check_key, read_lab_file

@@ -12,7 +12,8 @@ import pinocchio as pin
 import pytest
 
 from ur3hanoi.plan.checks.geometry import COLLISION_GEOMETRY, build_robot_geometry, robot_geometry
-from ur3hanoi.robot.model import ToolOffset, Ur3Model, load_ur3
+from ur3hanoi.robot.model import Ur3Model, load_ur3
+from ur3hanoi.robot.urdf import ToolOffset
 from ur3hanoi.station.calibration import Station
 
 

@@ -35,7 +35,9 @@ from ur3hanoi.plan.checks.collision import MAX_REPORTED, CollisionScene, clearan
 from ur3hanoi.plan.motion.sampling import evaluate
 from ur3hanoi.plan.motion.waypoints import geometry_key
 from ur3hanoi.plan.types import KinematicLimits, Phase, PlanConfig, Segment
-from ur3hanoi.robot.model import N_JOINTS, T_BASELINK_BASE, dh_link
+from ur3hanoi.robot.dh import dh_frames, dh_link
+from ur3hanoi.robot.model import T_BASELINK_BASE
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import block_center_world, table_z
 
@@ -112,21 +114,9 @@ class _Scene:
     def joint_frames(self, q: FloatArray) -> FloatArray:
         """(S, njoints, 4, 4) placements of the model's joints in base_link at the configurations ``q`` (S, 6): the
         DH chain (batched) times each joint's constant offset from its DH frame, i.e. Pinocchio's ``oMi``."""
-        S = len(q)
-        out = np.empty((S, self.model.njoints, 4, 4))
+        out = np.empty((len(q), self.model.njoints, 4, 4))
         out[:, 0] = np.eye(4)
-        T = np.broadcast_to(T_BASELINK_BASE.homogeneous, (S, 4, 4))
-        dh = self.station.robot.dh
-        DH_D, DH_A, DH_ALPHA = dh.d, dh.a, dh.alpha
-        for i in range(N_JOINTS):
-            ct, st = np.cos(q[:, i]), np.sin(q[:, i])
-            ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
-            A = np.zeros((S, 4, 4))
-            A[:, 0, 0], A[:, 0, 1], A[:, 0, 2], A[:, 0, 3] = ct, -st * ca, st * sa, DH_A[i] * ct
-            A[:, 1, 0], A[:, 1, 1], A[:, 1, 2], A[:, 1, 3] = st, ct * ca, -ct * sa, DH_A[i] * st
-            A[:, 2, 1], A[:, 2, 2], A[:, 2, 3] = sa, ca, DH_D[i]
-            A[:, 3, 3] = 1.0
-            T = T @ A
+        for i, T in enumerate(dh_frames(q, self.station.robot.dh, T_BASELINK_BASE.homogeneous)):
             out[:, i + 1] = T @ self.dh_to_joint[i]
         return out
 

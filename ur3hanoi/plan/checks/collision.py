@@ -23,7 +23,8 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.hanoi import Move, stacks_before_moves
 from ur3hanoi.plan.checks.geometry import robot_geometry
 from ur3hanoi.plan.types import DWELL_PHASES, VERTICAL_PHASES, KinematicLimits, Phase, PlanConfig, Trajectory
-from ur3hanoi.robot.model import N_JOINTS, load_ur3
+from ur3hanoi.robot.model import load_ur3
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import R_world_tcp_down, block_center_world, table_z
 

@@ -28,7 +28,7 @@ from ruckig import Trajectory as RuckigTrajectory
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.plan.types import SUCTION_PHASES, Segment, Trajectory, VerticalPath
-from ur3hanoi.robot.model import N_JOINTS
+from ur3hanoi.robot.registry import N_JOINTS
 
 _N_PIECES = 8  # pieces of a profile: 7 constant-jerk phases and the state after the end
 # Samples per block of the elementwise evaluation. Arrays are joint-major (6, N), so broadcasting a per-sample (N,)

@@ -22,7 +22,8 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PlanError
 from ur3hanoi.plan.types import KinematicLimits, VerticalPath
 from ur3hanoi.robot.ik import analytic_ik, branch_of, nearest_equivalent
-from ur3hanoi.robot.model import N_JOINTS, Ur3Model
+from ur3hanoi.robot.model import Ur3Model
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import ABOVE, ON, T_base_tcp
 

@@ -33,7 +33,7 @@ from ur3hanoi.plan.motion.corridor import Leg, State
 from ur3hanoi.plan.route import stored
 from ur3hanoi.plan.route.connections import Connection, StationPlanner, station_planner
 from ur3hanoi.plan.types import Phase, PlanConfig, Segment
-from ur3hanoi.robot.model import N_JOINTS
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import block_center_world, contact_point_world
 

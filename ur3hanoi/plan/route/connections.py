@@ -35,7 +35,8 @@ from ur3hanoi.plan.motion.vertical import PathLimits, line_ik
 from ur3hanoi.plan.motion.via import Pair, best_cells
 from ur3hanoi.plan.motion.waypoints import Waypoints, build_waypoints, geometry_key
 from ur3hanoi.plan.types import KinematicLimits
-from ur3hanoi.robot.model import N_JOINTS, load_ur3
+from ur3hanoi.robot.model import load_ur3
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import ABOVE, contact_point_world
 
