@@ -26,21 +26,25 @@ def add(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    print(write_key(args.calibration, args.key, args.output, args.solver, args.convention))
+    return 0
+
+
+def write_key(calibration: str, key: str, output: str, solver: str = "pinocchio", convention: str = "controller"
+              ) -> str:
+    """Generate ``key`` from ``calibration`` by IK and write it into the lab file ``output``, keeping every other
+    key (``tables -o``, and ``teach --table``); returns the line that says what was written."""
     from ur3hanoi.io.atomic import check_output
     from ur3hanoi.labfile.generated import generate_key
     from ur3hanoi.labfile.update import write_sections
 
-    inputs = [input_file(args.calibration)]
-    check_output(args.output, inputs=inputs)  # fail before the IK, not after
+    inputs = [input_file(calibration)]
+    check_output(output, inputs=inputs)  # fail before the IK, not after
     # An output file that is not YAML, or not a mapping of keys, is refused by write_sections before it writes (the
     # IK of a table takes about a millisecond: reading the file twice would cost more than it saves). The generated
     # key comes from the user's cache when the same calibration and ur3hanoi made it before: no NumPy then.
-    gen = generate_key(args.calibration, args.key, args.solver, args.convention,
-                       label=Path(args.calibration).as_posix())
-    write_sections(args.output, gen.sections, inputs=inputs)
-    print(
-        f"wrote {args.key} ({gen.n_towers} towers x {gen.n_heights} heights x 2) to {shown(args.output)}: "
-        f"max IK error {gen.max_position_error:.2e} m, {gen.max_orientation_error:.2e} rad (closed form, "
-        f"{gen.refined} of {gen.n_poses} poses refined by {gen.solver})"
-    )
-    return 0
+    gen = generate_key(calibration, key, solver, convention, label=Path(calibration).as_posix())
+    write_sections(output, gen.sections, inputs=inputs)
+    return (f"wrote {key} ({gen.n_towers} towers x {gen.n_heights} heights x 2) to {shown(output)}: "
+            f"max IK error {gen.max_position_error:.2e} m, {gen.max_orientation_error:.2e} rad (closed form, "
+            f"{gen.refined} of {gen.n_poses} poses refined by {gen.solver})")
