@@ -93,16 +93,20 @@ class Operator:
         assert self.at_mm is not None
         self.at_mm[axis] += mm
 
-    def reach(self, tower: int, height: int, error_mm: tuple[float, float, float]) -> np.ndarray:
-        """Jog from above the named pose to the hidden contact + ``error_mm``; returns where the suction point is
-        [mm, world]."""
-        self.go(tower, height)
+    def move_to(self, tower: int, height: int, error_mm: tuple[float, float, float]) -> np.ndarray:
+        """Jog to the hidden contact of (tower, height) + ``error_mm``: x and y first, so that the last moves are the
+        descent onto the block; returns where the suction point is [mm, world]."""
         target = contact_point_world(self.hidden, tower, height) * 1e3 + np.array(error_mm)
         assert self.at_mm is not None
-        for axis in (0, 1, 2):  # x and y first: the last move is the descent onto the block
+        for axis in (0, 1, 2):
             for mm in steps_for(float(target[axis] - self.at_mm[axis])):
                 self.jog(axis, mm)
         return self.at_mm.copy()
+
+    def reach(self, tower: int, height: int, error_mm: tuple[float, float, float]) -> np.ndarray:
+        """``g``, then :meth:`move_to`."""
+        self.go(tower, height)
+        return self.move_to(tower, height, error_mm)
 
     def wait_still(self) -> None:
         """Until the live status says the arm is still (as a person waits before pressing Enter)."""
@@ -116,3 +120,98 @@ class Operator:
         self.expect(r"next: [^\n]*\n")
         text: str = self.child.before + self.child.after
         return text
+
+
+ERRORS_MM = ((0.7, -0.5, 0.4), (-0.6, 0.6, 0.3), (0.5, 0.7, -0.4))
+"""The deliberate error of each good contact [mm] (about 1 mm, as a careful person jogs)."""
+OFF_MM = (9.0, 0.0, 12.0)
+"""The pose taught 15 mm off (then undone and taught again)."""
+
+
+def practice_session(child: Any, base: Station, hidden: Station) -> dict[str, Any]:
+    """The whole practice session on a running station, through teach's pseudo-terminal ``child``: three contacts
+    (the third first 15 mm off: named as a suspect, undone, taught again), an Enter while a jog step runs (refused),
+    then ``f``. Returns what the operator saw and did."""
+    import pexpect
+
+    op = Operator(child, base, hidden)
+    seen: dict[str, Any] = {"at_mm": []}
+    op.expect("next: tower 1 height 3")
+    seen["at_mm"].append(op.reach(0, 2, ERRORS_MM[0]).tolist())
+    op.record("tower 1 height 3")
+    child.send("g")
+    child.send("\r")  # at once: the arm is on its way above tower 2
+    op.expect("the arm is moving")
+    seen["moving_refused"] = True
+    op.expect("go above tower 2 height 1: done")
+    op.at_mm = H_world_tcp(base, 1, 0, ABOVE)[:3, 3] * 1e3
+    seen["at_mm"].append(op.move_to(1, 0, ERRORS_MM[1]).tolist())
+    op.record("tower 2 height 1")
+    op.reach(2, 0, OFF_MM)
+    seen["suspect"] = op.record("tower 3 height 1")
+    child.send("u")
+    op.expect("undone")
+    seen["at_mm"].append(op.move_to(2, 0, ERRORS_MM[2]).tolist())
+    seen["after"] = op.record("tower 3 height 1")
+    child.send("f")
+    child.expect(pexpect.EOF, timeout=180)
+    child.close()
+    seen["exit"] = child.exitstatus
+    return seen
+
+
+def screen_text(raw: str) -> str:
+    """A pseudo-terminal transcript as a person last saw it: the live status redraws (cursor up, clear) applied,
+    carriage returns dropped."""
+    lines: list[str] = []
+    current = ""
+    i = 0
+    while i < len(raw):
+        m = re.match(r"\x1b\[(\d*)([AJ])", raw[i:])
+        if m:
+            if m.group(2) == "A":
+                for _ in range(int(m.group(1) or 1)):
+                    current = lines.pop() if lines else ""
+            else:
+                current = ""
+            i += m.end()
+            continue
+        ch = raw[i]
+        if ch == "\n":
+            lines.append(current)
+            current = ""
+        elif ch == "\r":
+            if not raw.startswith("\n", i + 1):  # a bare carriage return: the line is written over
+                current = ""
+        else:
+            current += ch
+        i += 1
+    return "\n".join([*lines, current]).rstrip() + "\n"
+
+
+def main() -> int:
+    """``python -m tests.teach_operator DIR VIA [TEACH OPTIONS...]``: the practice session against a station that
+    runs ``DIR/hidden.yaml``; writes ``DIR/transcript.txt`` and prints the session's outcome as one JSON line."""
+    import json
+    import sys
+
+    import pexpect
+
+    folder, via, extra = Path(sys.argv[1]), sys.argv[2], sys.argv[3:]
+    hidden, base = load_station(folder / "hidden.yaml"), load_station("lab_real")
+    argv = ["-m", "ur3hanoi.cli", "teach", "--via", via, "--base", "lab_real", "-o", str(folder / "taught.yaml"),
+            "--table", str(folder / "lab2_data.yaml"), "--station-out", str(folder / "station.yaml"), *extra]
+    with (folder / "raw.txt").open("w") as raw:
+        child = pexpect.spawn(sys.executable, argv, encoding="utf-8", dimensions=(30, 150), timeout=60)
+        child.logfile_read = raw
+        try:
+            seen = practice_session(child, base, hidden)
+        finally:
+            child.close(force=True)
+    (folder / "transcript.txt").write_text(screen_text((folder / "raw.txt").read_text()))
+    print(json.dumps(seen))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -40,7 +40,7 @@ SHIFT_PRIOR_MM = 10.0
 AMBIGUOUS_COST = 2.0
 """Another point whose removal leaves a fit cheaper than this over the best one's could be the odd one out too."""
 _MAX_TURN_DEG = 45.0  # the turn is searched within +-this
-_GRID_DEG = 0.25  # coarse search step before the golden-section refinement
+_GRID_DEG = 1.0  # coarse search step before the golden-section refinement
 
 
 def _rot_z(theta: float) -> FloatArray:
