@@ -162,7 +162,8 @@ def practice_session(child: Any, base: Station, hidden: Station) -> dict[str, An
 
 def screen_text(raw: str) -> str:
     """A pseudo-terminal transcript as a person last saw it: the live status redraws (cursor up, clear) applied,
-    carriage returns dropped."""
+    carriage returns dropped (``raw`` as written: not read in text mode, which turns a lone carriage return into
+    a line break)."""
     lines: list[str] = []
     current = ""
     i = 0
@@ -208,7 +209,7 @@ def main() -> int:
             seen = practice_session(child, base, hidden)
         finally:
             child.close(force=True)
-    (folder / "transcript.txt").write_text(screen_text((folder / "raw.txt").read_text()))
+    (folder / "transcript.txt").write_text(screen_text((folder / "raw.txt").read_bytes().decode()))
     print(json.dumps(seen))
     return 0
 

@@ -53,7 +53,7 @@ def test_bad_options_get_one_line(argv: list[str], message: str, tmp_path: Path,
 
 @pytest.mark.parametrize(("base", "taught", "message"), [
     ("ur3hanoi/stations/taught_example.yaml", None, "taught_example.yaml"),  # a base calibration that is not one
-    ("lab_real", 'units: deg\nstation: "other"\npoints:\n  - {tower: 1, height: 1, q: [110, -64, 136, -161, -90, 20]}\n',
+    ("lab_real", 'units: deg\nstation: "other"\npoints:\n  - {tower: 1, height: 1, q: [110, -64, 136, -161, -90, 2]}\n',
      "taught for station 'other', not for 'lab_real_example'"),
     ("lab_real", TAUGHT.replace("deg", "rad").replace("110.87, -64.65, 136.28, -161.63, -90, 20.87",
                                                         "1.93, -1.13, 2.38, -2.82, -1.57, 0.36"),

@@ -64,7 +64,7 @@ def test_a_practice_session_teaches_the_hidden_station_and_ros_solve_solves_on_i
         seen = practice_session(child, load_station("lab_real"), load_station(folder / "hidden.yaml"))
     finally:
         child.close(force=True)
-    transcript = screen_text(raw.read_text())
+    transcript = screen_text(raw.read_bytes().decode())
     (folder / "transcript.txt").write_text(transcript)
     assert seen["exit"] == 0, transcript
     assert seen["moving_refused"]

@@ -159,7 +159,7 @@ def _session(args: argparse.Namespace, base: Station, base_label: str, taught: T
         if args.record_now is not None:
             _record_now(teacher, args.record_now, args.wait)
             return exit_codes.OK, teacher.taught
-        return _interactive(teacher, arm, names), teacher.taught
+        return _interactive(teacher, names), teacher.taught
     except DriverError as exc:
         kept = teacher.taught if teacher is not None else taught
         raise DriverError(f"{exc}: {_saved(kept)}; run the same command again when the driver is back") from None
@@ -191,7 +191,7 @@ def _record_now(teacher: Any, slot_1: tuple[int, int], wait_s: float) -> None:
         time.sleep(0.1)
 
 
-def _interactive(teacher: Any, arm: Any, names: DriverNames) -> int:
+def _interactive(teacher: Any, names: DriverNames) -> int:
     """The terminal session; the exit code (OK when finished with f)."""
     import os
     import signal
@@ -199,7 +199,7 @@ def _interactive(teacher: Any, arm: Any, names: DriverNames) -> int:
     from ur3hanoi.teach.interactive import run as run_session
     from ur3hanoi.teach.terminal import Keys, Screen, TerminalGoneError
 
-    kind = ("ur3hanoi's simulated station, no pendant: jog with the keys" if arm.simulated() else
+    kind = ("ur3hanoi's simulated station, no pendant: jog with the keys" if teacher.simulated else
             "not ur3hanoi's station: move the arm with the pendant's freedrive")
     n = len(teacher.taught.points)
     cont = f"; continuing {shown(teacher.taught.path)}: {n} point(s) recorded" if n else ""

@@ -106,7 +106,7 @@ class LayoutCheck:
             for a single point); with a point named, the others' distance from the fit without it.
         suspects: the points named (indices; at most one).
         ambiguous: True when another point over the threshold could be the odd one out as well.
-        theta_deg: the turn of the base's layout fitted to all points [deg].
+        theta_deg: the turn of the base's layout fitted to the points (all but the one named) [deg].
         shift_mm: its shift (3,) [mm].
     """
 
@@ -142,8 +142,8 @@ def check_layout(base_mm: Sequence[Sequence[float]] | FloatArray, measured_mm: S
         suspects = (best,)
         ambiguous = bool(np.sum(cost[over] < cost[best] + AMBIGUOUS_COST) > 1)
         others = [j for j in range(n) if j != best]
-        fit = fit_layout(a[others], b[others], pivot)
-        dev[others] = np.linalg.norm(b[others] - fit.apply(a[others]), axis=1)
+        whole = fit_layout(a[others], b[others], pivot)
+        dev[others] = np.linalg.norm(b[others] - whole.apply(a[others]), axis=1)
     return LayoutCheck(deviation_mm=dev, suspects=suspects, ambiguous=ambiguous,
                        theta_deg=math.degrees(whole.theta), shift_mm=whole.shift)
 

@@ -38,7 +38,7 @@ from ur3hanoi.teach.jog import (
 from ur3hanoi.teach.stillness import STILL_WINDOW_S, stillness
 from ur3hanoi.teach.taught_file import TaughtFile
 
-ARRIVED_RAD = 1e-3
+ARRIVED_RAD = 2e-4
 """[rad] a jog step has arrived when every joint is this close to its target."""
 ARRIVAL_MARGIN_S = 5.0
 """[s] a jog step not arrived this long after its motion should have ended is given up (the course's ROS 2 bridge
@@ -75,6 +75,7 @@ class Teacher:
         self.base, self.base_label, self.taught = base, base_label, taught
         self.driver, self.names, self.start = driver, names, start
         self.jogger = Jogger(base)
+        self.simulated = driver.simulated()  # asked once: a master lost later must not make it the real arm
         self.skipped: set[tuple[int, int]] = set()
         self.extra: Advice | None = None  # a pose named by hand (a), or a suspect to re-record
         self.step_index = 1
@@ -129,7 +130,7 @@ class Teacher:
         else:
             state = "still" if still.still else "waiting for positions"
         p = self.jogger.H_world_tcp(q)[:3, 3]
-        lines = [f"joints [deg] {' '.join(f'{v:8.2f}' for v in np.degrees(q))}   {state}",
+        lines = [f"joints [deg] {' '.join(f'{v + 0.0:8.2f}' for v in np.round(np.degrees(q), 2))}   {state}",
                  f"suction point {_mm(p)}   jog step {JOG_STEPS_MM[self.step_index]:g} mm"]
         if self.named is not None:
             d = (contact_point_world(self.base, self.named.tower, self.named.height) - p) * 1e3
@@ -197,7 +198,7 @@ class Teacher:
         """Lines that stop a motion key (a move under way, the real driver's first key), or None to go on."""
         if self.move is not None:
             return [f"the arm is still moving ({self.move.what}): key dropped"]
-        if not self.warned_real and not self.driver.simulated():
+        if not self.warned_real and not self.simulated:
             self.warned_real = True
             return [f"this driver is not ur3hanoi's station: jog keys move the real arm through {self.names.command} "
                     f"at {np.degrees(JOG_SPEED_RAD_S):.0f} deg/s; the pendant's freedrive is the normal way to teach. "
