@@ -49,8 +49,7 @@ def steps_for(delta_mm: float) -> list[int]:
     """The fewest signed 20 / 5 / 1 mm steps whose sum is ``delta_mm`` rounded to whole mm."""
     k = round(delta_mm)
     best: list[int] | None = None
-    a0, b0 = round(k / 20), round((k % 20) / 5)
-    for a, b in itertools.product(range(a0 - 1, a0 + 2), range(-4 + b0 - 4, b0 + 5)):
+    for a, b in itertools.product(range(round(k / 20) - 1, round(k / 20) + 2), range(-4, 5)):
         c = k - 20 * a - 5 * b
         steps = [20 * int(math.copysign(1, a))] * abs(a) + [5 * int(math.copysign(1, b))] * abs(b) + \
             [int(math.copysign(1, c))] * abs(c)
