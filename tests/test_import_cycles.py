@@ -149,3 +149,22 @@ def test_the_graph_sees_every_kind_of_import(tmp_path: Path) -> None:
     assert a_cycle(frozenset({"pkg.a", "pkg.b", "pkg.sub.c"}), graph) == ["pkg.a", "pkg.b", "pkg.sub.c", "pkg.a"]
     (pkg / "sub/c.py").write_text("X = 1\n")  # without the lazy import: no cycle
     assert cyclic_groups(import_graph(module_files(pkg))) == []
+
+
+TEACH_NEVER_REACHES = ("ur3hanoi.remote", "ur3hanoi.ros", "ur3hanoi.ros2", "ur3hanoi.cli", "ur3hanoi.sim",
+                       "ur3hanoi.replay", "ur3hanoi.plots")
+"""``ur3hanoi.teach`` sits beside the transports: it reaches none of them (nor the command line, the simulator or
+the pictures), directly or through what it imports; the command line passes it a driver client."""
+
+
+def test_teach_reaches_no_transport() -> None:
+    graph = import_graph(module_files())
+    reached: set[str] = set()
+    todo = [m for m in graph if m == "ur3hanoi.teach" or m.startswith("ur3hanoi.teach.")]
+    while todo:
+        node = todo.pop()
+        for child in graph[node] - reached:
+            reached.add(child)
+            todo.append(child)
+    bad = sorted(m for m in reached if any(m == p or m.startswith(f"{p}.") for p in TEACH_NEVER_REACHES))
+    assert not bad, f"ur3hanoi.teach reaches {bad}"
