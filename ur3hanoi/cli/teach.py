@@ -20,7 +20,7 @@ from ur3hanoi.cli.options import DRIVER_WAIT, TABLE_KEYS, UsageError, check_numb
 from ur3hanoi.cli.ros2 import add_dds_options
 
 if TYPE_CHECKING:
-    from ur3hanoi.station import Station
+    from ur3hanoi.station.calibration import Station
     from ur3hanoi.teach.driver import DriverNames
     from ur3hanoi.teach.taught_file import TaughtFile
 
@@ -90,14 +90,14 @@ def _connect(args: argparse.Namespace) -> tuple[Any, DriverNames]:
     """The connected arm of ``--via`` and how messages name it (RosError: no driver within ``--wait``)."""
     print(f"ur3hanoi teach: looking for the driver (at most {args.wait:g} s) ...", flush=True)
     if args.via == "ros":
-        from ur3hanoi.ros.client import ArmConfig, RosArm
+        from ur3hanoi.interface.ros1.client import ArmConfig, RosArm
 
         arm: Any = RosArm(ArmConfig(connect_timeout_s=args.wait), master_uri=args.master)
         where = arm.master_uri
     else:
-        from ur3hanoi.remote.errors import RosError
-        from ur3hanoi.ros2.client import Ros2Arm, Ros2ArmConfig
-        from ur3hanoi.ros2.dds import domain_id_from_env
+        from ur3hanoi.interface.errors import RosError
+        from ur3hanoi.interface.ros2.client import Ros2Arm, Ros2ArmConfig
+        from ur3hanoi.interface.ros2.dds import domain_id_from_env
 
         try:
             domain = domain_id_from_env() if args.domain_id is None else args.domain_id
@@ -115,7 +115,7 @@ def _connect(args: argparse.Namespace) -> tuple[Any, DriverNames]:
 
 def run(args: argparse.Namespace) -> int:
     from ur3hanoi.io.atomic import check_output
-    from ur3hanoi.station import load_station
+    from ur3hanoi.station.calibration import load_station
     from ur3hanoi.teach.taught_file import open_taught
 
     _check_options(args)

@@ -18,9 +18,9 @@ from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 from ur3hanoi.calibrate.grid_fit import choose_model, removable
-from ur3hanoi.grid import ON
-from ur3hanoi.labfile import Slot
-from ur3hanoi.station import Station
+from ur3hanoi.station.grid import ON
+from ur3hanoi.tables import Slot
+from ur3hanoi.station.calibration import Station
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ Each contact is judged where it can be judged best:
   the grid fitted to the other points, its suspects are the fit's;
 - a point the others cannot check (the only one of its tower: with one point per tower, every point) is judged
   against the base calibration's layout fitted to the other points (:mod:`ur3hanoi.teach.layout`), and named when
-  more than the audit's flag distance (:data:`ur3hanoi.calibrate.rule.CONTACT_FLAG_MM`, 8 mm) off.
+  more than the audit's flag distance (:data:`ur3hanoi.audit.rule.CONTACT_FLAG_MM`, 8 mm) off.
 
 Above poses (a hand-edited file may hold them) are judged by the fit only.
 """
@@ -23,13 +23,13 @@ import numpy as np
 
 from ur3hanoi.calibrate import CalibrationFit, fit_station
 from ur3hanoi.calibrate.grid_fit import GridSolution, choose_model, leave_one_out, measure, removable, solve
-from ur3hanoi.calibrate.rule import CONTACT_FLAG_MM
+from ur3hanoi.audit.rule import CONTACT_FLAG_MM
 from ur3hanoi.errors import TaughtPointsError, printable
-from ur3hanoi.grid import ON, contact_point_world
-from ur3hanoi.station import Station
-from ur3hanoi.taught import TaughtPoints
+from ur3hanoi.station.grid import ON, contact_point_world
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.calibrate.taught import TaughtPoints
 from ur3hanoi.teach.layout import check_layout
-from ur3hanoi.waypoints import pose_label
+from ur3hanoi.tables.ik_table import pose_label
 
 FIRST_FEEDBACK = 3
 """Feedback starts with this many points (one per tower of the lab's three)."""

@@ -23,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.grid import ABOVE, H_world_tcp, table_z
-from ur3hanoi.ik import analytic_ik, branch_of, nearest_equivalent
-from ur3hanoi.robot import Ur3Model, load_ur3
-from ur3hanoi.station import Station
+from ur3hanoi.station.grid import ABOVE, H_world_tcp, table_z
+from ur3hanoi.robot.ik import analytic_ik, branch_of, nearest_equivalent
+from ur3hanoi.robot.model import Ur3Model, load_ur3
+from ur3hanoi.station.calibration import Station
 
 JOG_STEPS_MM: tuple[float, ...] = (1.0, 5.0, 20.0)
 """[mm] the step sizes (keys 1, 2, 3); a turn steps by the same number of degrees."""

@@ -22,8 +22,8 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import printable
-from ur3hanoi.grid import ON, contact_point_world
-from ur3hanoi.station import Station
+from ur3hanoi.station.grid import ON, contact_point_world
+from ur3hanoi.station.calibration import Station
 from ur3hanoi.teach.advice import Advice, next_pose
 from ur3hanoi.teach.driver import Driver, DriverNames, latest
 from ur3hanoi.teach.feedback import FIRST_FEEDBACK, feedback

@@ -1,5 +1,5 @@
 """The taught-points file of a teach session: every record written at once, atomically, in the taught-points
-format ``calibrate --taught`` reads (:mod:`ur3hanoi.taught`), in degrees as on the pendant, one point a line.
+format ``calibrate --taught`` reads (:mod:`ur3hanoi.calibrate.taught`), in degrees as on the pendant, one point a line.
 
 A session on an existing file continues it: its points are read back (strictly: an invalid file is an error that
 names it, and nothing is written). A file in radians, one taught for another station (its ``station`` names
@@ -16,12 +16,12 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ur3hanoi.errors import TaughtPointsError, printable
-from ur3hanoi.grid import ON
+from ur3hanoi.station.grid import ON
 from ur3hanoi.io.atomic import atomic_write
-from ur3hanoi.labfile import Slot
-from ur3hanoi.station import Station
-from ur3hanoi.taught import DEG_DECIMALS, TaughtPoint, TaughtPoints, load_taught, taught_text
-from ur3hanoi.waypoints import pose_label
+from ur3hanoi.tables import Slot
+from ur3hanoi.station.calibration import Station
+from ur3hanoi.calibrate.taught import DEG_DECIMALS, TaughtPoint, TaughtPoints, load_taught, taught_text
+from ur3hanoi.tables.ik_table import pose_label
 
 
 def _rounded(q: tuple[float, ...]) -> tuple[float, ...]:

@@ -6,10 +6,10 @@ from __future__ import annotations
 import pytest
 
 from ur3hanoi.calibrate.grid_fit import choose_model, removable
-from ur3hanoi.station import Station, load_station
+from ur3hanoi.station.calibration import Station, load_station
 from ur3hanoi.teach.advice import next_pose, required_height
 
-from .conftest import LAB_REAL, LAB_SIM
+from tests.conftest import LAB_REAL, LAB_SIM
 
 
 @pytest.fixture(scope="module")

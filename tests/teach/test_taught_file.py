@@ -11,12 +11,12 @@ import pytest
 
 from ur3hanoi.cli import main
 from ur3hanoi.errors import TaughtPointsError
-from ur3hanoi.station import Station, load_station
-from ur3hanoi.taught import DEG_DECIMALS, load_taught
+from ur3hanoi.station.calibration import Station, load_station
+from ur3hanoi.calibrate.taught import DEG_DECIMALS, load_taught
 from ur3hanoi.teach.taught_file import open_taught
-from ur3hanoi.waypoints import generate_table
+from ur3hanoi.tables.ik_table import generate_table
 
-from .conftest import LAB_REAL
+from tests.conftest import LAB_REAL
 
 
 @pytest.fixture(scope="module")

@@ -8,12 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from ur3hanoi.grid import ABOVE, H_world_tcp
-from ur3hanoi.ik import branch_of
-from ur3hanoi.station import Station, load_station
+from ur3hanoi.station.grid import ABOVE, H_world_tcp
+from ur3hanoi.robot.ik import branch_of
+from ur3hanoi.station.calibration import Station, load_station
 from ur3hanoi.teach.jog import JOG_ACCEL_RAD_S2, JOG_SPEED_RAD_S, MAX_STEP_JOINT_DEG, Jogger, move_time_s
 
-from .conftest import LAB_REAL
+from tests.conftest import LAB_REAL
 
 
 @pytest.fixture(scope="module")

@@ -8,13 +8,13 @@ import math
 import numpy as np
 import pytest
 
-from ur3hanoi.station import Station, load_station
-from ur3hanoi.taught import TaughtPoint, TaughtPoints
+from ur3hanoi.station.calibration import Station, load_station
+from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
 from ur3hanoi.teach.feedback import BY_LAYOUT, BY_POINTS, feedback
 from ur3hanoi.teach.jog import Jogger
-from ur3hanoi.waypoints import generate_table
+from ur3hanoi.tables.ik_table import generate_table
 
-from .conftest import LAB_REAL
+from tests.conftest import LAB_REAL
 
 
 @pytest.fixture(scope="module")

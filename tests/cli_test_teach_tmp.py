@@ -1,6 +1,6 @@
 """``ur3hanoi teach`` without a driver: bad input gets one line and leaves TAUGHT as it was; ``--finish`` writes
 the calibration and the table key (keeping the lab file's other keys) from a taught file; no terminal, no
-session. The sessions themselves run against the real stations: tests/test_teach_ros.py, tests/test_teach_dds.py."""
+session. The sessions themselves run against the real stations: tests/teach/test_ros.py, tests/teach/test_dds.py."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from ur3hanoi.cli import main
-from ur3hanoi.labfile import read_recorded_table
-from ur3hanoi.station import load_station
+from ur3hanoi.tables import read_recorded_table
+from ur3hanoi.station.calibration import load_station
 from ur3hanoi.teach.taught_file import open_taught
-from ur3hanoi.waypoints import generate_table
+from ur3hanoi.tables.ik_table import generate_table
 
 TAUGHT = "units: deg\npoints:\n  - {tower: 1, height: 1, q: [110.87, -64.65, 136.28, -161.63, -90, 20.87]}\n"
 
@@ -52,7 +52,7 @@ def test_bad_options_get_one_line(argv: list[str], message: str, tmp_path: Path,
 
 
 @pytest.mark.parametrize(("base", "taught", "message"), [
-    ("ur3hanoi/stations/taught_example.yaml", None, "taught_example.yaml"),  # a base calibration that is not one
+    ("ur3hanoi/station/shipped/taught_example.yaml", None, "taught_example.yaml"),  # a base calibration that is not one
     ("lab_real", 'units: deg\nstation: "other"\npoints:\n  - {tower: 1, height: 1, q: [110, -64, 136, -161, -90, 2]}\n',
      "taught for station 'other', not for 'lab_real_example'"),
     ("lab_real", TAUGHT.replace("deg", "rad").replace("110.87, -64.65, 136.28, -161.63, -90, 20.87",

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from ur3hanoi.calibrate.rule import CONTACT_FLAG_MM
+from ur3hanoi.audit.rule import CONTACT_FLAG_MM
 from ur3hanoi.teach.layout import check_layout, fit_layout
 
 BLOCK_MM = 31.8

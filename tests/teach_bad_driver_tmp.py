@@ -1,5 +1,5 @@
 """A driver no UR controller would be: publishes ``ur3/position`` with the JSON list of joint values given (5 of
-them, or a NaN) at 50 Hz until killed (a helper process of tests/test_teach_ros.py). Prints ``publishing`` once
+them, or a NaN) at 50 Hz until killed (a helper process of tests/teach/test_ros.py). Prints ``publishing`` once
 registered."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import json
 import sys
 import time
 
-from ur3hanoi.ros.env import import_rospy
-from ur3hanoi.ros.msgs import load_messages
+from ur3hanoi.interface.ros1.env import import_rospy
+from ur3hanoi.interface.ros1.msgs import load_messages
 
 
 def main() -> int:

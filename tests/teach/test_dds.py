@@ -1,5 +1,5 @@
 """``ur3hanoi teach --via ros2`` against the real Cyclone DDS ``ros2-station`` in a private network namespace (marked
-``dds``, wall clock): the same practice session as over ROS 1 (tests/teach_operator.py drives teach's
+``dds``, wall clock): the same practice session as over ROS 1 (tests/support/teach_operator.py drives teach's
 pseudo-terminal inside the namespace), on the hidden station, then ``ros2-solve`` with the written table.
 
 The station runs ``--timing honest`` (each command as the controller's movej at the message's v and a) so that the
@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.ros2_support import REPO, in_netns, requires_netns
-from tests.teach_operator import ERRORS_MM, JOG_RESOLUTION_MM, write_hidden_station
-from ur3hanoi.station import load_station
+from tests.support.ros2_support import REPO, in_netns, requires_netns
+from tests.support.teach_operator import ERRORS_MM, JOG_RESOLUTION_MM, write_hidden_station
+from ur3hanoi.station.calibration import load_station
 
 pytestmark = [pytest.mark.dds, requires_netns]
 
@@ -30,7 +30,7 @@ $UR3HANOI ros2-station --calibration {tmp_path}/hidden.yaml --timing honest --re
   > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
 wait_ready {tmp_path}/st.out || exit 90
-{sys.executable} -m tests.teach_operator {tmp_path} ros2 > {tmp_path}/operator.json || {{ kill -INT $ST; exit 91; }}
+{sys.executable} -m tests.support.teach_operator {tmp_path} ros2 > {tmp_path}/operator.json || {{ kill -INT $ST; exit 91; }}
 $UR3HANOI ros2-solve --table {tmp_path}/lab2_data.yaml --key real_pos --calibration {tmp_path}/station.yaml \\
   --start 1 --end 3 --v 4 --a 4 --json
 CODE=$?

@@ -1,5 +1,5 @@
 """``ur3hanoi teach`` over ROS 1 against the real ``ros-station`` (a real roscore, Debian's rospy; marked ``ros``,
-wall clock), driven through its pseudo-terminal by a scripted operator (tests/teach_operator.py).
+wall clock), driven through its pseudo-terminal by a scripted operator (tests/support/teach_operator.py).
 
 The station runs a hidden calibration (``lab_real``'s grid turned 2 deg and moved 5, -4, 1 mm): the operator jogs
 with teach's own keys to three contacts with about 1 mm of deliberate error, the fitted grid matches the hidden one
@@ -26,14 +26,15 @@ import numpy as np
 import pexpect
 import pytest
 
-from tests.ros_support import final_slots, free_port, requires_ros, ros_env, roscore, run, station, ur3hanoi_cmd
-from tests.teach_operator import ERRORS_MM, JOG_RESOLUTION_MM, practice_session, screen_text, write_hidden_station
-from ur3hanoi.station import load_station
-from ur3hanoi.taught import load_taught
+from tests.support import SUPPORT
+from tests.support.ros_support import final_slots, free_port, requires_ros, ros_env, roscore, run, station, ur3hanoi_cmd
+from tests.support.teach_operator import ERRORS_MM, JOG_RESOLUTION_MM, practice_session, screen_text, write_hidden_station
+from ur3hanoi.station.calibration import load_station
+from ur3hanoi.calibrate.taught import load_taught
 
 pytestmark = [pytest.mark.ros, requires_ros]
 
-TESTS = Path(__file__).resolve().parent
+
 
 
 def spawn_teach(env: dict[str, str], cwd: Path, *args: str, log: Path | None = None) -> Any:
@@ -144,7 +145,7 @@ def test_no_driver_or_a_driver_of_5_joints_or_nan_gets_one_line(tmp_path):
             result.stderr
         for values, problem in (([0.1] * 5, "publishes 5 joint values (expected 6) on ur3/position"),
                                 ([0.1, float("nan"), 0.1, 0.1, 0.1, 0.1], "publishes a non-finite joint value")):
-            driver = subprocess.Popen([sys.executable, str(TESTS / "teach_bad_driver.py"), json.dumps(values)],
+            driver = subprocess.Popen([sys.executable, str(SUPPORT / "teach_bad_driver.py"), json.dumps(values)],
                                       env=env, stdout=subprocess.PIPE, text=True, start_new_session=True)
             try:
                 assert driver.stdout is not None and driver.stdout.readline().startswith("publishing")

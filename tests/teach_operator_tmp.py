@@ -19,9 +19,9 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ur3hanoi.grid import ABOVE, H_world_tcp, contact_point_world
-from ur3hanoi.resources import station_file
-from ur3hanoi.station import Station, load_station
+from ur3hanoi.station.grid import ABOVE, H_world_tcp, contact_point_world
+from ur3hanoi.io.resources import station_file
+from ur3hanoi.station.calibration import Station, load_station
 
 HIDDEN_TURN_DEG = 2.0
 HIDDEN_SHIFT_M = (0.005, -0.004, 0.001)
@@ -190,7 +190,7 @@ def screen_text(raw: str) -> str:
 
 
 def main() -> int:
-    """``python -m tests.teach_operator DIR VIA [TEACH OPTIONS...]``: the practice session against a station that
+    """``python -m tests.support.teach_operator DIR VIA [TEACH OPTIONS...]``: the practice session against a station that
     runs ``DIR/hidden.yaml``; writes ``DIR/transcript.txt`` and prints the session's outcome as one JSON line."""
     import json
     import sys
