@@ -14,6 +14,7 @@ Hierarchy::
     |   +-- TaughtPointsError   a taught-points file (or a table used as taught points)
     |   +-- TableError          a lab-format waypoint table (lab2_data.yaml)
     +-- OutputError             an output path cannot be written safely (nothing was written)
+    +-- DriverError             the arm's driver stopped or publishes what no UR driver does (``teach``)
     +-- IKError, PuzzleError, PlanError, SimulationError
     +-- SuctionFaultError       suction feedback says no block is held (the lab's halt condition)
 """
@@ -109,6 +110,11 @@ class OutputError(Ur3HanoiError):
     Raised before anything is written, or after a failed write that was rolled back: the old file, if any, is
     byte-identical and no temporary file is left behind.
     """
+
+
+class DriverError(Ur3HanoiError):
+    """The arm's driver stopped publishing its position, or publishes what no UR driver does (not six finite joint
+    angles): a teach session cannot go on (what was recorded is saved)."""
 
 
 class IKError(Ur3HanoiError):

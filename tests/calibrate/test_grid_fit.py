@@ -12,6 +12,7 @@ from ur3hanoi.calibrate.grid_fit import (
     default_height_step,
     leave_one_out,
     measure,
+    removable,
     solve,
 )
 from ur3hanoi.station.calibration import Station
@@ -73,6 +74,16 @@ def test_a_point_the_fit_needs_cannot_be_left_out(lab_real: Station) -> None:
     p = _noisy_points(lab_real, slots, 3)
     model = choose_model(lab_real, slots)
     assert model is not None
-    loo, removable = leave_one_out(model, slots, p, solve(lab_real, model, slots, p))
-    assert removable.tolist() == [True, True, True, True, False]
+    loo, can = leave_one_out(model, slots, p, solve(lab_real, model, slots, p))
+    assert can.tolist() == [True, True, True, True, False]
     assert np.isnan(loo[4]).all() and np.isfinite(loo[:4]).all()
+    assert removable(model, slots).tolist() == can.tolist()  # from the slots alone, as teach's advice asks it
+
+
+def test_one_point_per_tower_leaves_every_point_unchecked(lab_real: Station) -> None:
+    slots = [(0, 2, ON), (1, 0, ON), (2, 0, ON)]
+    model = choose_model(lab_real, slots)
+    assert model is not None and not removable(model, slots).any()
+    both = [*slots, (0, 0, ON), (1, 2, ON), (2, 2, ON)]
+    model = choose_model(lab_real, both)
+    assert model is not None and removable(model, both).all()

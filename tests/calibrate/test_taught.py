@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
 from pathlib import Path
@@ -10,7 +11,7 @@ import pytest
 import yaml
 
 from tests.conftest import REPO
-from ur3hanoi.calibrate.taught import load_taught, parse_taught, taught_from_table
+from ur3hanoi.calibrate.taught import load_taught, parse_taught, taught_from_table, taught_text
 from ur3hanoi.errors import TableError, TaughtPointsError
 from ur3hanoi.io.resources import TAUGHT_EXAMPLE, stations_dir
 from ur3hanoi.station.grid import ABOVE, ON
@@ -28,6 +29,22 @@ def test_load_taught_converts_degrees(tmp_path: Path) -> None:
     assert p.label == "points[0] (tower 1 height 2 above)"
     assert p.q == pytest.approx([math.radians(v) for v in HOME_DEG], abs=1e-15)
     assert taught.sha256 == hashlib.sha256(f.read_bytes()).hexdigest()
+
+
+def test_taught_text_reads_back_with_its_station_and_above_poses() -> None:
+    taught = parse_taught(yaml.safe_load("units: deg\npoints:\n- {tower: 2, height: 1, q: [110.87, -64.65, 136.28, "
+                                         "-161.63, -90, 20.87]}\n- {tower: 3, height: 2, pose: above, q: [157.43, "
+                                         "-118.07, 141.68, -113.6, -90, 67.43]}\n"))
+    assert taught.station == "" and taught.units == "deg"
+    text = taught_text(taught.points, 'my "station"', ["a comment"])
+    assert text.startswith("# a comment\nunits: deg\n")
+    back = parse_taught(yaml.safe_load(text))
+    assert back.station == 'my "station"'
+    assert [(p.tower, p.height, p.k) for p in back.points] == [(1, 0, ON), (2, 1, ABOVE)]
+    for a, b in zip(back.points, taught.points, strict=True):
+        assert a.q == pytest.approx(b.q, abs=1e-15)
+    tiny = taught_text([dataclasses.replace(back.points[0], q=(-1e-9,) * 6)], "s")
+    assert "q: [0.0000, 0.0000" in tiny and "-0.0000" not in tiny
 
 
 def test_shipped_example_loads() -> None:

@@ -216,27 +216,43 @@ def solve(base: Station, model: GridModel, slots: Sequence[Slot], p_world: Float
     return GridSolution(origins=x[:3 * n_t].reshape(n_t, 3), step=step, approach=approach)
 
 
+def _leave_one_out_blocks(model: GridModel, slots: Sequence[Slot]) -> list[FloatArray | None]:
+    """Per point, ``I - H_ii`` (the 3x3 diagonal block of the hat matrix taken from the identity), or None when it
+    is singular: the point alone determines some unknown."""
+    A = model.design(slots)
+    inv = np.linalg.pinv(A.T @ A)
+    out: list[FloatArray | None] = []
+    for i in range(len(slots)):
+        Ai = A[3 * i:3 * i + 3]
+        M = np.eye(3) - Ai @ inv @ Ai.T
+        out.append(M if float(np.min(np.linalg.eigvalsh(0.5 * (M + M.T)))) > _SINGULAR else None)
+    return out
+
+
+def removable(model: GridModel, slots: Sequence[Slot]) -> BoolArray:
+    """Per point of ``slots`` (which determine ``model``): True when the others determine the grid without it, so
+    that it can be checked against them; False when it alone determines some unknown (the only point of its tower,
+    say): the audit calls such a point ``unchecked``. Depends on the slots only, not on the measurements."""
+    return np.array([m is not None for m in _leave_one_out_blocks(model, slots)], dtype=bool)
+
+
 def leave_one_out(model: GridModel, slots: Sequence[Slot], p_world: FloatArray, solution: GridSolution
                   ) -> tuple[FloatArray, BoolArray]:
     """Deviation of each point from the grid fitted to the others, for the points ``solution`` was fitted to.
 
     Returns:
         (deviations (N, 3) [m, world], NaN rows where undefined; removable (N,), False for a point that alone
-        determines some unknown). A default (unfitted) height step is held at its fitted value.
+        determines some unknown, :func:`removable`). A default (unfitted) height step is held at its fitted value.
     """
     n = len(slots)
-    A = model.design(slots)
     residual = p_world - solution.points(slots)
     out = np.full((n, 3), np.nan)
-    removable = np.zeros(n, dtype=bool)
-    inv = np.linalg.pinv(A.T @ A)
-    for i in range(n):
-        Ai = A[3 * i:3 * i + 3]
-        M = np.eye(3) - Ai @ inv @ Ai.T
-        if float(np.min(np.linalg.eigvalsh(0.5 * (M + M.T)))) > _SINGULAR:
+    can = np.zeros(n, dtype=bool)
+    for i, M in enumerate(_leave_one_out_blocks(model, slots)):
+        if M is not None:
             out[i] = np.linalg.solve(M, residual[i])
-            removable[i] = True
-    return out, removable
+            can[i] = True
+    return out, can
 
 
 __all__ = [
@@ -248,6 +264,7 @@ __all__ = [
     "default_height_step",
     "leave_one_out",
     "measure",
+    "removable",
     "rotation_error_deg",
     "solve",
 ]

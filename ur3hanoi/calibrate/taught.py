@@ -4,6 +4,7 @@ Taught-points file. Towers and heights are numbered from 1, as people count them
 bottom block of the first tower, ``Q[0][0]`` of ``lab2_data.yaml``); a 0 is an error that says so::
 
     units: deg            # deg | rad (required: a pose in the wrong unit is caught, see below)
+    station: lab_real_example   # optional: the name of the base calibration the poses were taught for
     points:               # contact ("on") poses unless `pose: above`
       - {tower: 1, height: 1, q: [..6 joint values..]}
       - {tower: 2, height: 1, q: [...]}
@@ -18,11 +19,15 @@ under ``units: deg``) are caught by their size. Alternatively every entry ``Q[t]
 a taught point (:func:`taught_from_table`); the missing entries and the "above" poses shared by the heights of a
 tower are recorded with them (see :mod:`ur3hanoi.tables`).
 
+``ur3hanoi teach`` records the poses the driver publishes into such a file (:func:`taught_text` writes it, in
+degrees, naming its ``station``); ``calibrate`` does not read ``station``.
+
 In code, :class:`TaughtPoint` holds 0-based indices (``tower = 0`` is the first tower), like ``Q[tower][height]``.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -30,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from ur3hanoi.errors import TaughtPointsError, printable
-from ur3hanoi.io.schema import Choice, Field, ListOf, Number, Record, Vector
+from ur3hanoi.io.schema import Choice, Field, ListOf, Number, Record, Text, Vector
 from ur3hanoi.io.schema import validate as validate_schema
 from ur3hanoi.io.yaml_loader import load_yaml_file
 from ur3hanoi.robot.registry import N_JOINTS
@@ -41,9 +46,12 @@ from ur3hanoi.tables import RecordedTable, Slot, read_recorded_table
 UNITS: tuple[str, ...] = ("deg", "rad")
 MAX_TAUGHT_POINTS = 1000
 _TWO_PI = 2 * math.pi
+DEG_DECIMALS = 4
+"""Decimals of a joint angle written in degrees (0.0001 deg: under 1 um at the UR3's reach)."""
 
 TAUGHT_SCHEMA = Record({
     "units": Field(Choice(UNITS)),
+    "station": Field(Text(max_len=255), required=False),
     "points": Field(ListOf(Record({
         "tower": Field(Number(1, MAX_TOWERS, integer=True, what="a tower number (numbering starts at 1)")),
         "height": Field(Number(1, MAX_HEIGHTS, integer=True, what="a height (numbering starts at 1: 1 = bottom)")),
@@ -97,6 +105,8 @@ class TaughtPoints:
         sha256: hex digest of the file's bytes.
         missing: for a table, its missing entries ``(tower, height, k)`` (0-based); else ``()``.
         shape: for a table, its ``(towers, heights)``; else None.
+        units: the file's ``units`` (the points are in radians whatever it says).
+        station: the file's ``station`` ("" when it names none).
     """
 
     points: tuple[TaughtPoint, ...]
@@ -104,6 +114,8 @@ class TaughtPoints:
     sha256: str
     missing: tuple[Slot, ...] = ()
     shape: tuple[int, int] | None = None
+    units: str = "rad"
+    station: str = ""
 
 
 def _fail(source: str, msg: str) -> TaughtPointsError:
@@ -144,7 +156,20 @@ def parse_taught(data: Any, source: str = "<memory>", sha256: str = "") -> Taugh
     _check_units(source, [p.q for p in raw], units, [p.label for p in raw])
     scale = math.pi / 180.0 if units == "deg" else 1.0
     points = tuple(replace(p, q=tuple(v * scale for v in p.q)) for p in raw)
-    return TaughtPoints(points=points, source=source, sha256=sha256)
+    return TaughtPoints(points=points, source=source, sha256=sha256, units=units, station=data.get("station", ""))
+
+
+def taught_text(points: Sequence[TaughtPoint], station: str, header: Sequence[str] = ()) -> str:
+    """A taught-points file of ``points`` (joint angles [rad]) in degrees with :data:`DEG_DECIMALS` decimals, one
+    point a line, naming ``station``; ``header`` lines are written first as comments. :func:`parse_taught` reads it
+    back to the rounding."""
+    lines = [f"# {line}" for line in header]
+    lines += ["units: deg", f"station: {json.dumps(station)}", "points:"]
+    for p in points:
+        pose = ", pose: above" if p.k == ABOVE else ""
+        q = ", ".join(f"{round(math.degrees(v), DEG_DECIMALS) + 0.0:.{DEG_DECIMALS}f}" for v in p.q)
+        lines.append(f"  - {{tower: {p.tower + 1}, height: {p.height + 1}{pose}, q: [{q}]}}")
+    return "\n".join(lines) + "\n"
 
 
 def load_taught(path: str | Path) -> TaughtPoints:
@@ -181,6 +206,7 @@ def taught_from_recorded(table: RecordedTable) -> TaughtPoints:
 
 
 __all__ = [
+    "DEG_DECIMALS",
     "MAX_TAUGHT_POINTS",
     "TAUGHT_SCHEMA",
     "UNITS",
@@ -190,4 +216,5 @@ __all__ = [
     "parse_taught",
     "taught_from_recorded",
     "taught_from_table",
+    "taught_text",
 ]

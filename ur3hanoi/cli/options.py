@@ -52,6 +52,8 @@ CMD_ACCELERATION = Number(0.0, 20.0, lo_open=True, unit="rad/s^2",
                           what="a commanded joint acceleration (the driver caps it)")
 GRASP_TIMEOUT = Number(0.0, 10.0, lo_open=True, unit="s", what="a wait for the vacuum switch")
 DURATION = Number(0.0, 7 * 86400.0, lo_open=True, unit="s", what="a run time")
+# teach.
+DRIVER_WAIT = Number(0.5, 600.0, unit="s", what="a wait for the driver")
 
 _MAX_TEXT = 40  # longer option values are not numbers anyone means (and int() of 5000 digits is refused anyway)
 
@@ -92,6 +94,17 @@ def station_number(what: str) -> Callable[[str], int]:
 
     parse.__name__ = what
     return parse
+
+
+def slot(text: str) -> tuple[int, int]:
+    """An argparse ``type=`` for ``TOWER,HEIGHT`` (1-based, e.g. ``2,1``); the ranges are the station's, checked once
+    it is loaded (:func:`check_number`)."""
+    parts = text.split(",")
+    values = [_parse(p, integer=True) for p in parts] if len(parts) == 2 else []
+    if len(values) != 2 or any(v is None for v in values):
+        raise argparse.ArgumentTypeError(f"{quote(text)} is invalid: expected TOWER,HEIGHT, e.g. 2,1 (tower 2, "
+                                         "height 1; numbered from 1)")
+    return int(values[0]), int(values[1])  # type: ignore[arg-type]
 
 
 def check_number(option_name: str, value: int | None, hi: int, what: str, why: str = "") -> None:

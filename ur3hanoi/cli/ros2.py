@@ -47,7 +47,7 @@ def _domain(text: str) -> int:
     return value
 
 
-def _add_dds_options(p: argparse.ArgumentParser) -> None:
+def add_dds_options(p: argparse.ArgumentParser) -> None:
     """``--convention``, ``--network``, ``--domain-id``."""
     p.add_argument("--convention", choices=["course", "controller"], default="course",
                    help="joint convention on the topics (default course, the bridge's)")
@@ -67,7 +67,7 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--timing", choices=["bridge", "honest"], default="bridge",
                    help="bridge: fixed 2 s moves, is_ready always true (default); honest: the controller's movej at "
                         "the message's v and a, is_ready = arrived")
-    _add_dds_options(p)
+    add_dds_options(p)
     remote.add_station_outputs(p)
     p.set_defaults(func=_run_station)
 
@@ -90,7 +90,7 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
         sub, "ros2-solve", _SOLVE_HELP, _SOLVE_DESCRIPTION,
         f"station calibration: the table's source and the home pose (default {DEFAULT_ROS2_CALIBRATION})",
         ("; the course bridge ignores it", "; ignored by the bridge"), 1.0)
-    _add_dds_options(p)
+    add_dds_options(p)
     remote.add_json_option(p)
     p.set_defaults(func=_run_solve)
 

@@ -26,23 +26,27 @@ def add(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    print(write_key(args.calibration, args.key, args.output, args.solver, args.convention))
+    return 0
+
+
+def write_key(calibration: str, key: str, output: str, solver: str = "pinocchio", convention: str = "controller"
+              ) -> str:
+    """Generate ``key`` from ``calibration`` by IK and write it into the lab file ``output``, keeping every other
+    key (``tables -o``, and ``teach --table``); returns the line that says what was written."""
     from ur3hanoi.io.atomic import check_output
     from ur3hanoi.station.calibration import load_station
     from ur3hanoi.tables.ik_table import generate_table
     from ur3hanoi.tables.write import write_table
 
-    inputs = [input_file(args.calibration)]
-    check_output(args.output, inputs=inputs)  # fail before the IK, not after
+    inputs = [input_file(calibration)]
+    check_output(output, inputs=inputs)  # fail before the IK, not after
     # An output file that is not YAML, or not a mapping of keys, is refused by the write before it writes (the IK of
     # a table takes about a millisecond: reading the file twice would cost more than it saves).
-    station = load_station(args.calibration)
-    table = generate_table(station, args.solver)
-    write_table(args.output, table, args.key, Path(args.calibration).as_posix(), inputs=inputs,
-                convention=args.convention)
+    station = load_station(calibration)
+    table = generate_table(station, solver)
+    write_table(output, table, key, Path(calibration).as_posix(), inputs=inputs, convention=convention)
     refined = sum(r.iterations > 0 for r in table.results)
-    print(
-        f"wrote {args.key} ({station.n_towers} towers x {station.n_heights} heights x 2) to {shown(args.output)}: "
-        f"max IK error {table.max_position_error:.2e} m, {table.max_orientation_error:.2e} rad (closed form, "
-        f"{refined} of {len(table.results)} poses refined by {table.solver})"
-    )
-    return 0
+    return (f"wrote {key} ({station.n_towers} towers x {station.n_heights} heights x 2) to {shown(output)}: "
+            f"max IK error {table.max_position_error:.2e} m, {table.max_orientation_error:.2e} rad (closed form, "
+            f"{refined} of {len(table.results)} poses refined by {table.solver})")

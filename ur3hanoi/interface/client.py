@@ -10,6 +10,11 @@ re-sending the last *commanded* destination (the lab sends the measured position
 by its tracking error). A binding (:class:`ur3hanoi.interface.ros1.client.RosArm` on rospy,
 :class:`ur3hanoi.interface.ros2.client.Ros2Arm` on Cyclone DDS) connects, sends and receives; it calls
 :meth:`TopicArm._position` and :meth:`TopicArm._feedback` with what arrives.
+
+For ``ur3hanoi teach`` (:mod:`ur3hanoi.teach`) the arm also keeps the positions of the last
+:data:`HISTORY_S` seconds with their arrival times (:meth:`TopicArm.samples`: is the arm still?), sends a move
+without waiting at a speed of the caller's (:meth:`TopicArm.send`), and names a position message that is not six
+finite angles (:attr:`TopicArm.malformed`) instead of taking it.
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -25,6 +31,10 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.interface.errors import RosError
+
+HISTORY_S = 2.0
+"""[s] how long the arm keeps the positions that arrived (:meth:`TopicArm.samples`)."""
+_HISTORY_MAX = 4000  # positions kept at most: 2 s at 2 kHz, more than any driver publishes
 
 
 @dataclass(frozen=True)
@@ -79,6 +89,9 @@ class TopicArm:
         self.log = log if log is not None else (lambda s: print(s, file=sys.stderr))
         self._q: FloatArray | None = None  # controller convention
         self._t_position = -math.inf  # time.monotonic() of the last position message
+        self._history: deque[tuple[float, FloatArray]] = deque(maxlen=_HISTORY_MAX)
+        self.malformed = ""
+        """What was wrong with the last position message that was not six finite angles ("" if none was)."""
         self._digin: int | None = None
         self._ain0 = float("nan")
         self._destination: FloatArray | None = None
@@ -89,8 +102,9 @@ class TopicArm:
     def _poll(self) -> None:
         """Take what arrived (a binding whose callbacks run in their own threads has nothing to do)."""
 
-    def _publish(self, destination: FloatArray, io_0: bool) -> Any:
-        """Send a command (``destination`` [rad, controller convention]); returns the message for re-publishing."""
+    def _publish(self, destination: FloatArray, io_0: bool, v: float, a: float) -> Any:
+        """Send a command (``destination`` [rad, controller convention], joint speed ``v`` [rad/s] and acceleration
+        ``a`` [rad/s^2]); returns the message for re-publishing."""
         raise NotImplementedError
 
     def _republish(self, msg: Any) -> None:
@@ -102,9 +116,18 @@ class TopicArm:
         raise NotImplementedError
 
     def _position(self, q: FloatArray) -> None:
-        """A position message arrived: ``q`` [rad, controller convention]."""
+        """A position message arrived: ``q`` [rad, controller convention]; one that is not six finite angles is
+        named in :attr:`malformed` and not taken."""
+        if q.shape != (6,) or not bool(np.all(np.isfinite(q))):
+            self.malformed = (f"{q.size} joint values (expected 6)" if q.shape != (6,) else
+                              f"a non-finite joint value ({', '.join(f'{x:g}' for x in q.tolist())})")
+            return
+        now = time.monotonic()
         self._q = q
-        self._t_position = time.monotonic()
+        self._t_position = now
+        self._history.append((now, q))
+        while self._history[0][0] < now - HISTORY_S:
+            self._history.popleft()
 
     def _feedback(self, digin: int, ain0: float) -> None:
         """A gripper-input message arrived: the digital inputs and the analog input 0 [V]."""
@@ -118,8 +141,12 @@ class TopicArm:
             RosError: naming what did not appear within ``connect_timeout_s`` on ``where`` and the ``driver``
                 that should be running.
         """
-        ok = self.wait_until(lambda: self._q is not None and self._digin is not None and self._subscribed(),
+        ok = self.wait_until(lambda: bool(self.malformed) or (self._q is not None and self._digin is not None
+                                                                and self._subscribed()),
                              self.config.connect_timeout_s)
+        if self.malformed and self._q is None:
+            raise RosError(f"the driver on {where} publishes {self.malformed} on {self.topics.position}: is it a UR "
+                           f"driver ({driver})?")
         if not ok:
             t = self.topics
             missing = [name for name, seen in ((t.position, self._q is not None), (t.gripper, self._digin is not None),
@@ -141,6 +168,21 @@ class TopicArm:
         """The vacuum switch: ``DIGIN`` bit 0."""
         self._poll()
         return bool((self._digin or 0) & 1)
+
+    def samples(self, window_s: float) -> list[tuple[float, FloatArray]]:
+        """The positions that arrived in the last ``window_s`` seconds (at most :data:`HISTORY_S`), oldest first:
+        ``(time.monotonic() of arrival, q [rad, controller convention])``."""
+        self._poll()
+        since = time.monotonic() - window_s
+        return [(t, q) for t, q in list(self._history) if t >= since]
+
+    def send(self, q: FloatArray, v: float, a: float) -> None:
+        """Command a joint move to ``q`` [rad] at joint speed ``v`` [rad/s] and acceleration ``a`` [rad/s^2] (the
+        current suction state), without waiting."""
+        goal = np.array(q, dtype=float)
+        self._publish(goal, self._io, v, a)
+        self.commands_sent += 1
+        self._destination = goal
 
     def feedback_text(self) -> str:
         return f"{self.topics.digital}={self._digin}, {self.topics.analog}={self._ain0:.2f} V"
@@ -165,7 +207,7 @@ class TopicArm:
         """
         cfg = self.config
         goal = np.array(q, dtype=float)
-        msg = self._publish(goal, self._io)
+        msg = self._publish(goal, self._io, cfg.v, cfg.a)
         self.commands_sent += 1
         self._destination = goal
         t0 = last = time.monotonic()

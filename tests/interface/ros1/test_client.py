@@ -48,7 +48,37 @@ def test_a_driver_that_stops_publishing_is_named_within_the_position_timeout(mon
     arm = RosArm(ArmConfig(position_timeout_s=0.2, move_timeout_s=30.0, republish_s=100.0), master_uri="http://x:1",
                  log=lambda s: None)
     arm._pub = _Pub()
-    monkeypatch.setattr(arm, "_publish", lambda goal, io: object())
+    monkeypatch.setattr(arm, "_publish", lambda goal, io, v, a: object())
     arm._on_position(type("P", (), {"position": [0.0] * 6})())  # one message, then silence
     with pytest.raises(RosError, match=r"position updates stopped: no message on /ur3/position for 0\.\d s"):
         arm.move(np.full(6, 0.657))
+
+
+def test_positions_are_kept_with_their_arrival_times_and_a_malformed_one_is_named_not_taken():
+    """What `teach` asks of the arm: the positions of the last seconds (is the arm still?), and a driver that
+    publishes 5 joints or NaN named instead of taken."""
+    import math
+    import time
+
+    import numpy as np
+
+    from ur3hanoi.interface.client import HISTORY_S
+
+    arm = RosArm(master_uri="http://x:1", log=lambda s: None)
+    t0 = time.monotonic()
+    for i in range(5):
+        arm._on_position(type("P", (), {"position": [0.1 * i] * 6})())
+    window = arm.samples(10.0)
+    assert [round(float(q[0]), 9) for _, q in window] == [0.0, 0.1, 0.2, 0.3, 0.4]
+    times = [t for t, _ in window]
+    assert t0 <= times[0] and times == sorted(times) and times[-1] <= time.monotonic()
+    assert arm.malformed == ""
+    arm._on_position(type("P", (), {"position": [0.1] * 5})())
+    assert arm.malformed == "5 joint values (expected 6)" and float(arm.q[0]) == 0.4
+    arm._on_position(type("P", (), {"position": [0.1, math.nan, 0.1, 0.1, 0.1, 0.1]})())
+    assert arm.malformed.startswith("a non-finite joint value (0.1, nan,")
+    assert len(arm.samples(10.0)) == 5 and HISTORY_S >= 0.5  # stillness needs at least half a second
+    sent: list[tuple[object, ...]] = []
+    arm._publish = lambda goal, io, v, a: sent.append((tuple(np.round(goal, 3)), io, v, a))  # type: ignore[method-assign]
+    arm.send(np.full(6, 0.5), 0.35, 0.7)
+    assert sent == [((0.5,) * 6, False, 0.35, 0.7)] and arm.commands_sent == 1

@@ -71,6 +71,13 @@ class RosArm(TopicArm):
         rospy.Subscriber("/ur3/gripper_input", msgs.gripper_input, self._on_gripper, tcp_nodelay=True)
         self._await_driver(self.master_uri, "ros-station or the course's ur3_driver")
 
+    def simulated(self) -> bool:
+        """True when the driver is ur3hanoi's ``ros-station`` (its node is registered with the master)."""
+        from ur3hanoi.interface.ros1.master import node_registered
+        from ur3hanoi.interface.ros1.server import NODE_NAME
+
+        return node_registered(self.master_uri, f"/{NODE_NAME}")
+
     def close(self) -> None:
         """Unregister the node."""
         if self._rospy is not None:
@@ -80,9 +87,8 @@ class RosArm(TopicArm):
     def _subscribed(self) -> bool:
         return bool(self._pub.get_num_connections() > 0)
 
-    def _publish(self, destination: FloatArray, io_0: bool) -> Any:
-        msg = self._msgs.command(destination=[float(x) for x in destination], v=self.config.v, a=self.config.a,
-                                 io_0=io_0)
+    def _publish(self, destination: FloatArray, io_0: bool, v: float, a: float) -> Any:
+        msg = self._msgs.command(destination=[float(x) for x in destination], v=v, a=a, io_0=io_0)
         self._pub.publish(msg)
         return msg
 

@@ -54,6 +54,8 @@ from ur3hanoi.interface.server import CoreOptions, StationCore
 
 READY_LINE = "ur3hanoi ros-station: ready"
 """Written (and flushed) on stderr once the node is up: scripts wait for it."""
+NODE_NAME = "ur3hanoi_station"
+"""The station's node name (``ur3hanoi teach`` looks for it to know there is no pendant)."""
 
 
 @dataclass(frozen=True)
@@ -144,7 +146,7 @@ class RosStation(StationCore):
                 env = listen_env(dict(os.environ, ROS_MASTER_URI=self.master_uri), self.options.host)
                 os.environ.pop("ROS_HOSTNAME", None)
                 os.environ.update(env)
-                rospy.init_node("ur3hanoi_station", argv=[sys.argv[0]], disable_signals=True)
+                rospy.init_node(NODE_NAME, argv=[sys.argv[0]], disable_signals=True)
                 pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
                 pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
                 rospy.Subscriber("/ur3/command", msgs.command, self.on_command, queue_size=100)

@@ -55,6 +55,7 @@ class Ros2Arm(TopicArm):
         self._node: Any = None
         self._pub: Any = None
         self._readers: tuple[Any, Any] | None = None
+        self._spawn: Any = None
 
     def connect(self) -> None:
         """Join the domain and wait for the bridge's position and feedback and a ``ur3e/command`` subscriber.
@@ -63,14 +64,21 @@ class Ros2Arm(TopicArm):
             RosError: they do not appear within ``connect_timeout_s``.
         """
         from ur3hanoi.interface.ros2.dds import Ros2Node
-        from ur3hanoi.interface.ros2.msgs import CommandUR3e, GripperInput, PositionUR3e
+        from ur3hanoi.interface.ros2.msgs import CommandUR3e, GripperInput, Int32, PositionUR3e
+        from ur3hanoi.interface.ros2.server import TOPIC_SPAWN
 
         self._node = node = Ros2Node("ur3hanoi_solve", self.domain_id, self.network)
         self._pub = node.publisher(TOPICS.command, CommandUR3e)
         self._readers = (node.subscription(TOPICS.position, PositionUR3e),
                          node.subscription(TOPICS.gripper, GripperInput))
+        # Never written: only ur3hanoi's station subscribes it, so a match says there is no pendant (simulated()).
+        self._spawn = node.publisher(TOPIC_SPAWN, Int32)
         node.announce()
         self._await_driver(f"ROS_DOMAIN_ID {self.domain_id} ({self.network})", "ros2-station or the course's bridge")
+
+    def simulated(self) -> bool:
+        """True when the driver is ur3hanoi's ``ros2-station`` (it subscribes ``ur3hanoi/spawn``)."""
+        return self._spawn is not None and len(self._spawn.get_matched_subscriptions()) > 0
 
     def close(self) -> None:
         if self._node is not None:
@@ -83,8 +91,9 @@ class Ros2Arm(TopicArm):
             return
         pos, grip = self._readers
         for msg in pos.take(N=100):
-            if hasattr(msg, "position") and len(msg.position) == 6:
-                self._position(to_controller(np.array(msg.position, dtype=float), self.config.convention))
+            if hasattr(msg, "position"):
+                q = np.array(msg.position, dtype=float)
+                self._position(to_controller(q, self.config.convention) if q.shape == (6,) else q)
         for msg in grip.take(N=100):
             if hasattr(msg, "dig_in"):
                 self._feedback(int(msg.dig_in), float(msg.a_in0))
@@ -92,11 +101,11 @@ class Ros2Arm(TopicArm):
     def _subscribed(self) -> bool:
         return len(self._pub.get_matched_subscriptions()) > 0
 
-    def _publish(self, destination: FloatArray, io_0: bool) -> Any:
+    def _publish(self, destination: FloatArray, io_0: bool, v: float, a: float) -> Any:
         from ur3hanoi.interface.ros2.msgs import CommandUR3e
 
         dest = from_controller(np.asarray(destination, dtype=float), self.config.convention)
-        msg = CommandUR3e(destination=[float(x) for x in dest], v=self.config.v, a=self.config.a, io_0=io_0)
+        msg = CommandUR3e(destination=[float(x) for x in dest], v=v, a=a, io_0=io_0)
         self._pub.write(msg)
         return msg
 
