@@ -45,7 +45,7 @@ def _environment(phase: str, root: Path) -> dict[str, str]:
     env = dict(os.environ, PATH=f"{Path(sys.prefix) / 'bin'}{os.pathsep}{os.environ.get('PATH', '')}",
                PYTHONUNBUFFERED="1")
     if phase == "ros":
-        from tests.ros_support import free_port
+        from tests.support.ros_support import free_port
 
         (root / "ros_home").mkdir()
         env.update(ROS_MASTER_URI=f"http://127.0.0.1:{free_port()}", ROS_HOME=str(root / "ros_home"),
@@ -57,12 +57,12 @@ def _environment(phase: str, root: Path) -> dict[str, str]:
 
 def _command(phase: str, script: str) -> list[str]:
     if phase == "ros":
-        from tests.ros_support import ROS_INSTALLED
+        from tests.support.ros_support import ROS_INSTALLED
 
         if not ROS_INSTALLED and not os.environ.get("CI"):
             pytest.skip("ROS 1 not installed (run tools/ensure-system-deps.sh as root)")
     if phase == "dds":
-        from tests.ros2_support import NETNS_PROBLEM
+        from tests.support.ros2_support import NETNS_PROBLEM
 
         if NETNS_PROBLEM is not None:
             pytest.skip(NETNS_PROBLEM)
