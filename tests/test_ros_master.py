@@ -112,3 +112,31 @@ def test_the_guard_stops_the_master_and_removes_its_logs_on_sigterm_too(tmp_path
             os.kill(pid, 0)
     finally:
         core.stop()
+
+
+@pytest.mark.ros
+@requires_ros
+def test_the_master_the_guard_starts_obeys_sigint_and_the_guard_stops_on_sigint(tmp_path, monkeypatch):
+    """The guard's rosmaster starts with SIGINT at its default (it inherited the guard's ignored SIGINT across exec,
+    and every stop waited 15 s for a SIGKILL): a SIGINT stops it at once. A SIGINT to the guard stops it cleanly."""
+    env = ros_env(free_port(), tmp_path)
+    monkeypatch.setenv("ROS_HOME", env["ROS_HOME"])
+    uri = env["ROS_MASTER_URI"]
+    core = RosCore(uri)
+    try:
+        core.start()
+        pid, guard = master_pid(uri), core.guard_pid
+        assert pid is not None and guard is not None
+        os.kill(pid, signal.SIGINT)
+        deadline = time.monotonic() + 2.0
+        while alive(pid) and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert not alive(pid) and not master_answers(uri), "rosmaster ignored SIGINT"
+        assert alive(guard)  # it reports the exit and waits for its station
+        os.kill(guard, signal.SIGINT)
+        deadline = time.monotonic() + 2.0
+        while alive(guard) and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert not alive(guard) and core.log_dir is not None and not core.log_dir.exists()
+    finally:
+        core.stop()
