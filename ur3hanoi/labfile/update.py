@@ -22,7 +22,7 @@ from ur3hanoi.errors import TableError, printable
 from ur3hanoi.io.atomic import locked_output
 from ur3hanoi.io.reading import read_input_bytes
 from ur3hanoi.labfile import unchanged
-from ur3hanoi.labfile.file import WHAT, LabFile, check_key, parse_lab_file
+from ur3hanoi.labfile.file import WHAT, LabFile, check_key, parse_lab_file, warn_confusable
 from ur3hanoi.labfile.format import ANGLE_DECIMALS
 from ur3hanoi.labfile.sections import Sections
 
@@ -55,13 +55,16 @@ def write_sections(path: str | Path, sections: Sections, inputs: Sequence[str | 
         from ur3hanoi.labfile.splice import splice_yaml
 
         old = parse_lab_file(raw, out.shown) if raw is not None else LabFile(data={}, text="", sha256="")
+        # A look-alike of a key written is warned about (one of a key present, by parse_lab_file already), and the
+        # file is not remembered as unchanged: the warning comes again next time.
+        confusable = warn_confusable(old.data, out.shown, [k for k in sections.text if k not in old.data])
         try:
             text = splice_yaml(old.text, sections.text, sections.headers, sections.values)
         except TableError as exc:
             raise TableError(f"{printable(out.shown)}: cannot write '{key}': {exc}; file left unchanged") from None
         _check_read_back(text, old, sections, out.shown)
         out.write(BOM + text if old.bom else text)
-        if raw is not None and text == old.text:
+        if raw is not None and text == old.text and not confusable:
             unchanged.remember(raw, sections)
     return text
 
