@@ -307,16 +307,34 @@ def _wait_line(st: Station, text: str, timeout_s: float) -> float | None:
     return None
 
 
-def test_its_own_master_killed_under_a_running_station_is_started_again(tmp_path):
+def _solve(env: dict[str, str]) -> subprocess.Popen[str]:
+    """``ros-solve 1 -> 3`` started, once it has said it is connected."""
+    solve = subprocess.Popen(ur3hanoi_cmd("ros-solve", "--start", "1", "--end", "3"), env=env, text=True,
+                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             start_new_session=True)
+    assert solve.stdout is not None and "connected to" in solve.stdout.readline()
+    return solve
+
+
+def test_its_own_master_killed_under_a_running_station_is_started_again_and_ros_solve_stops(tmp_path):
+    """The station says so within 2 s, starts its master again and registers with it (a node started now finds
+    it). ros-solve, whose master is gone, exits 2 with one line although the station still publishes."""
     env = ros_env(free_port(), tmp_path)
     uri = env["ROS_MASTER_URI"]
+    port = uri.rsplit(":", 1)[1]
     with station(env, tmp_path) as st:
-        old = master_pid(uri)
-        assert old is not None
-        os.kill(old, signal.SIGKILL)
-        said = _wait_line(st, f"the ROS master at {uri} is gone (nothing listens on port", 2.0)
-        assert said is not None, f"nothing said within 2 s:\n{st.log()}"
-        assert _wait_line(st, "started the ROS master again", 10.0) is not None, st.log()
+        solve = _solve(env)
+        try:
+            old = master_pid(uri)
+            assert old is not None
+            os.kill(old, signal.SIGKILL)
+            said = _wait_line(st, f"the ROS master at {uri} is gone (nothing listens on port {port} any more)", 2.0)
+            assert said is not None, f"nothing said within 2 s:\n{st.log()}"
+            assert _wait_line(st, "started the ROS master again", 10.0) is not None, st.log()
+            _, err = solve.communicate(timeout=30)
+        finally:
+            if solve.poll() is None:
+                os.killpg(solve.pid, signal.SIGKILL)
         new = master_pid(uri)
         assert new not in (None, old) and new in descendants(st.proc.pid)
         # A node started now finds the station: the new master knows its topics.
@@ -327,28 +345,23 @@ def test_its_own_master_killed_under_a_running_station_is_started_again(tmp_path
     assert [e["event"] for e in report["master_events"]] == ["lost", "restarted"]
     assert report["master_events"][1]["pid"] == new and report["roscore_started"]
     assert not master_answers(uri) and not alive(new)
+    assert solve.returncode == 2, err
+    assert err.splitlines() == [f"ur3hanoi: error: the ROS master at {uri} is gone (nothing listens on port {port} "
+                                "any more): ros-solve stops; is the station (or roscore) still running?"], err
 
 
-def test_a_master_the_station_did_not_start_vanishing_stops_it_and_ros_solve_with_one_line(tmp_path):
+def test_a_master_the_station_did_not_start_vanishing_stops_it_with_one_line(tmp_path):
     env = ros_env(free_port(), tmp_path)
     uri = env["ROS_MASTER_URI"]
     port = uri.rsplit(":", 1)[1]
     with roscore(env):
         master = master_pid(uri)
+        assert master is not None
         with station(env, tmp_path) as st:
-            solve = subprocess.Popen(ur3hanoi_cmd("ros-solve", "--start", "1", "--end", "3"), env=env, text=True,
-                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     start_new_session=True)
-            try:
-                assert solve.stdout is not None and "connected to" in solve.stdout.readline()
-                os.kill(master, signal.SIGKILL)
-                t0 = time.monotonic()
-                code = st.proc.wait(timeout=30)
-                took = time.monotonic() - t0
-                out, err = solve.communicate(timeout=30)
-            finally:
-                if solve.poll() is None:
-                    os.killpg(solve.pid, signal.SIGKILL)
+            os.kill(master, signal.SIGKILL)
+            t0 = time.monotonic()
+            code = st.proc.wait(timeout=30)
+            took = time.monotonic() - t0
             st.kill()
     said = [line.rstrip("\n") for line in st.stderr if not line.startswith("ur3hanoi ros-station: ready")]
     assert code == 2 and took < 2.0, f"exit {code} after {took:.1f} s:\n{st.log()}"
@@ -356,6 +369,3 @@ def test_a_master_the_station_did_not_start_vanishing_stops_it_and_ros_solve_wit
                     "station did not start it, so it stops: start the master again, then the station"], st.log()
     report = st.read_report()
     assert not report["roscore_started"] and [e["event"] for e in report["master_events"]] == ["lost"]
-    assert solve.returncode == 2, out + err
-    assert err.splitlines() == [f"ur3hanoi: error: the ROS master at {uri} is gone (nothing listens on port {port} "
-                                "any more): ros-solve stops; is the station (or roscore) still running?"], err

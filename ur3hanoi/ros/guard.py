@@ -109,13 +109,24 @@ def orphaned(pid: int) -> bool:
     return False
 
 
-def _children() -> list[int]:
+def _children(pid: int | None = None) -> list[int]:
+    """The children of process ``pid`` (default: this one)."""
     pids: list[int] = []
     with contextlib.suppress(OSError):
-        for task in Path(f"/proc/{os.getpid()}/task").iterdir():
+        for task in Path(f"/proc/{os.getpid() if pid is None else pid}/task").iterdir():
             with contextlib.suppress(OSError):
                 pids += [int(p) for p in (task / "children").read_text().split()]
     return pids
+
+
+def _tree(pid: int) -> list[int]:
+    """``pid`` and every process below it."""
+    found, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        found.append(p)
+        todo += [c for c in _children(p) if c not in found]
+    return found
 
 
 def _reap() -> None:
@@ -132,13 +143,15 @@ def _wait(proc: subprocess.Popen[bytes], timeout_s: float) -> bool:
 
 
 def stop_tree(proc: subprocess.Popen[bytes], grace_s: tuple[float, ...] = STOP_GRACE_S) -> None:
-    """SIGINT ``proc`` (once per entry of ``grace_s``, waiting that long [s] after each), then SIGKILL every process
+    """SIGINT ``proc`` and every process below it, all at once (roscore's nodes then stop together instead of one
+    after the other), once per entry of ``grace_s``, waiting that long [s] after each; then SIGKILL every process
     left among this (subreaper) process's children."""
     for wait_s in grace_s:
         if proc.poll() is not None:
             break
-        with contextlib.suppress(ProcessLookupError):
-            proc.send_signal(signal.SIGINT)
+        for pid in _tree(proc.pid):
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGINT)
         if _wait(proc, wait_s):
             break
     deadline = time.monotonic() + 5.0
