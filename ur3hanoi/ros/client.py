@@ -60,7 +60,7 @@ class RosArm(TopicArm):
         from ur3hanoi.ros.env import import_rospy
         from ur3hanoi.ros.master import MasterUri, master_pid
         from ur3hanoi.ros.msgs import load_messages
-        from ur3hanoi.ros.watch import MasterWatch
+        from ur3hanoi.ros.watch import MasterWatch, quick_shutdown
 
         MasterUri.parse(self.master_uri)
         pid = master_pid(self.master_uri, timeout=2.0)
@@ -71,6 +71,7 @@ class RosArm(TopicArm):
         rospy = self._rospy = import_rospy()
         os.environ["ROS_MASTER_URI"] = self.master_uri
         rospy.init_node("ur3hanoi_solve", anonymous=True, argv=[sys.argv[0]], disable_signals=True)
+        quick_shutdown()
         self._pub = rospy.Publisher("/ur3/command", msgs.command, queue_size=10)
         rospy.Subscriber("/ur3/position", msgs.position, self._on_position, tcp_nodelay=True)
         rospy.Subscriber("/ur3/gripper_input", msgs.gripper_input, self._on_gripper, tcp_nodelay=True)

@@ -175,7 +175,7 @@ class RosStation(StationCore):
         from ur3hanoi.ros.env import import_rospy, import_std_msgs
         from ur3hanoi.ros.master import RosCore, listen_env, master_pid
         from ur3hanoi.ros.msgs import load_messages
-        from ur3hanoi.ros.watch import MasterWatch
+        from ur3hanoi.ros.watch import MasterWatch, quick_shutdown
 
         msgs = load_messages()
         rospy = self._rospy = import_rospy()
@@ -193,6 +193,7 @@ class RosStation(StationCore):
                 os.environ.pop("ROS_HOSTNAME", None)
                 os.environ.update(env)
                 rospy.init_node("ur3hanoi_station", argv=[sys.argv[0]], disable_signals=True)
+                quick_shutdown()
                 pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
                 pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
                 rospy.Subscriber("/ur3/command", msgs.command, self.on_command, queue_size=100)

@@ -8,8 +8,10 @@ connections but gives no answer for :data:`NO_ANSWER_S` -- so it is noticed with
 Then ``on_lost(reason)`` runs in the watch thread: ``ros-station`` starts its own master again and registers again
 (:func:`reregister`), ``ros-solve`` stops (:class:`ur3hanoi.ros.client.RosArm`).
 
-:func:`forget_master` keeps rospy from unregistering with a master that is gone (or not the node's) when it shuts
-down: rospy's XML-RPC calls have no time limit, and a master that accepts and never answers would hold the exit.
+Helpers on rospy's registration: :func:`quick_shutdown` takes 0.5 s off rospy's shutdown (a station stops in 0.5 s
+instead of 1 s); :func:`forget_master` keeps rospy from unregistering with a master that is gone (or not the node's)
+when it shuts down: rospy's XML-RPC calls have no time limit, and a master that accepts and never answers would hold
+the exit.
 """
 
 from __future__ import annotations
@@ -128,6 +130,21 @@ def reregister() -> int:
     return len(entries)
 
 
+def quick_shutdown() -> None:
+    """Make this rospy node's shutdown 0.5 s shorter (call after ``init_node``): rospy waits for its registration
+    thread, which sleeps on a condition 0.5 s at a time and is woken only before rospy raises its shutdown flag;
+    waking it once more after the flag lets it end at once."""
+    reg = _reg_manager()
+    if reg is None:
+        return
+
+    def wake(_reason: str) -> None:
+        with reg.cond:
+            reg.cond.notify_all()
+
+    importlib.import_module("rospy.core").add_shutdown_hook(wake)
+
+
 def forget_master() -> None:
     """Keep rospy from unregistering with its master when it shuts down (the master is gone, or not this node's)."""
     with contextlib.suppress(ImportError):
@@ -136,4 +153,4 @@ def forget_master() -> None:
             reg.master_uri = None
 
 
-__all__ = ["NO_ANSWER_S", "WATCH_PERIOD_S", "MasterWatch", "forget_master", "reregister"]
+__all__ = ["NO_ANSWER_S", "WATCH_PERIOD_S", "MasterWatch", "forget_master", "quick_shutdown", "reregister"]
