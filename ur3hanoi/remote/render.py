@@ -67,10 +67,12 @@ def _worker(parent: int, conn: Connection, calibration: str, n_blocks: int, fram
             mujoco.mj_forward(scene.model, scene.data)
             recorder(scene.model, scene.data)
             conn.send(recorder.count)
-    except (_StoppedError, EOFError, OSError):  # stopped, or the station is gone: no half-written output
+    except BaseException as exc:  # no half-written output, whatever stopped the loop
         recorder.discard()
         recorder.close()
-        return
+        if isinstance(exc, _StoppedError | EOFError | OSError):
+            return  # SIGTERM, or the station is gone
+        raise
     recorder.close()
     conn.send("closed")
 
