@@ -94,8 +94,9 @@ class Proc:
     """A station subprocess in its own session; its output lines are collected, ``ready`` set on its ready line."""
 
     def __init__(self, cmd: list[str], env: dict[str, str], ready_word: str) -> None:
+        # Run in the source folder: ``python -m`` puts the working folder first on the path, before PYTHONPATH.
         self.proc = subprocess.Popen(cmd, env=env, text=True, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, start_new_session=True)
+                                     stderr=subprocess.PIPE, start_new_session=True, cwd=env["PYTHONPATH"])
         self.lines: list[str] = []
         self.ready = threading.Event()
         for stream in (self.proc.stdout, self.proc.stderr):
