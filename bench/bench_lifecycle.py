@@ -175,7 +175,7 @@ def ros1_restart(source: Path, tmp: Path) -> dict[str, Any]:
         old_gone = gone[0] if gone else None
         time.sleep(1.0)
         sys.path.insert(0, str(source))
-        from ur3hanoi.ros.master import node_registered
+        from ur3hanoi.interface.ros1.master import node_registered
 
         kept = second.proc.poll() is None and node_registered(uri, "/ur3hanoi_station")
         return {"ready_s": ready_s, "old_gone_s": old_gone, "kept": kept}
@@ -214,7 +214,7 @@ def ros2_restart(source: Path, tmp: Path) -> dict[str, Any]:
     from cyclonedds.core import InstanceState
     from cyclonedds.domain import Domain, DomainParticipant
 
-    from ur3hanoi.ros2.dds import cyclone_config
+    from ur3hanoi.interface.ros2.dds import cyclone_config
 
     domain = Domain(0, cyclone_config())
     participant = DomainParticipant(0)

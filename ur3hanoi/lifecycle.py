@@ -9,10 +9,10 @@ signal (``PR_SET_PDEATHSIG``) when its parent dies, even by SIGKILL, where no cl
 
 Processes ur3hanoi starts (each stopped on its parent's every exit path: normal end, error, SIGINT, SIGTERM, SIGKILL):
 
-- the roscore guard (:mod:`ur3hanoi.ros.guard`, own session): the end of file on its stdin pipe (the station closed
+- the roscore guard (:mod:`ur3hanoi.interface.ros1.guard`, own session): the end of file on its stdin pipe (the station closed
   it or died), SIGINT or SIGTERM stop it; it stops rosmaster/roscore, which starts with SIGINT and SIGTERM at their
   defaults and dies with the guard;
-- the station's rendering process (:mod:`ur3hanoi.remote.render`, ``spawn``): its pipe, SIGTERM, its parent's death;
+- the station's rendering process (:mod:`ur3hanoi.interface.render`, ``spawn``): its pipe, SIGTERM, its parent's death;
   it ignores SIGINT on purpose (a Ctrl-C must not cut the video short: the station finishes it);
 - ``solve --video``'s rendering workers (:class:`ur3hanoi.sim.render.OffscreenRecorder`, a ``spawn`` pool):
   ``Pool.terminate`` (SIGTERM), their parent's death; ffmpeg (imageio-ffmpeg's) ends at the end of file of its

@@ -6,7 +6,7 @@ it. :class:`MasterWatch` asks the master for its pid (``getPid``) every :data:`W
 when nothing listens on its port any more, when another master (another pid) answers there, or when it accepts
 connections but gives no answer for :data:`NO_ANSWER_S` -- so it is noticed within about a second, well within 2 s.
 Then ``on_lost(reason)`` runs in the watch thread: ``ros-station`` starts its own master again and registers again
-(:func:`reregister`), ``ros-solve`` stops (:class:`ur3hanoi.ros.client.RosArm`).
+(:func:`reregister`), ``ros-solve`` stops (:class:`ur3hanoi.interface.ros1.client.RosArm`).
 
 Helpers on rospy's registration: :func:`quick_shutdown` takes 0.5 s off rospy's shutdown (a station stops in 0.5 s
 instead of 1 s); :func:`forget_master` keeps rospy from unregistering with a master that is gone (or not the node's)
@@ -23,8 +23,8 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from ur3hanoi.remote.errors import RosError
-from ur3hanoi.ros.master import MasterUri, probe_master
+from ur3hanoi.interface.errors import RosError
+from ur3hanoi.interface.ros1.master import MasterUri, probe_master
 
 WATCH_PERIOD_S = 0.25
 """How often [s] the master is asked for its pid."""

@@ -1,7 +1,7 @@
 """How ``ros2-station`` stops and restarts, measured from inside the tests' private network namespace (a helper
-process of tests/test_ros2_station.py: run it only through :func:`tests.ros2_support.in_netns`).
+process of tests/interface/ros2/test_server.py: run it only through :func:`tests.ros2_support.in_netns`).
 
-Usage: ``python tests/ros2_lifecycle_probe.py MODE DIR``; prints one JSON object.
+Usage: ``python tests/support/ros2_lifecycle_probe.py MODE DIR``; prints one JSON object.
 
 - ``restart``: a station is SIGKILLed and another started at once on the same domain. Measures the seconds from the
   kill until the dead station's participant leaves the DDS graph (its ghost), and whether the new station
@@ -26,8 +26,8 @@ from typing import Any
 from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsParticipant
 from cyclonedds.core import InstanceState
 
-from ur3hanoi.ros2.dds import Ros2Node
-from ur3hanoi.ros2.msgs import PositionUR3e
+from ur3hanoi.interface.ros2.dds import Ros2Node
+from ur3hanoi.interface.ros2.msgs import PositionUR3e
 
 
 def children(pid: int) -> set[int]:
