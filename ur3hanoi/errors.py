@@ -17,6 +17,9 @@ Hierarchy::
     +-- DriverError             the arm's driver stopped or publishes what no UR driver does (``teach``)
     +-- IKError, PuzzleError, PlanError, SimulationError
     +-- SuctionFaultError       suction feedback says no block is held (the lab's halt condition)
+
+A :class:`Ur3HanoiWarning` (:mod:`warnings`) says something the user should know without stopping anything (the
+command line prints it as ``ur3hanoi: warning: ...``).
 """
 
 from __future__ import annotations
@@ -147,3 +150,7 @@ class SuctionFaultError(Ur3HanoiError):
     def __init__(self, message: str, result: object | None = None) -> None:
         super().__init__(message)
         self.result = result
+
+
+class Ur3HanoiWarning(UserWarning):
+    """Something the user should know that stops nothing (one line, like an error's message)."""

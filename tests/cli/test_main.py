@@ -462,8 +462,11 @@ def test_solve_and_ros_solve_accept_and_refuse_the_same_tables(case: str, accept
         ("{tower: 1, height: 3,", "{tower: 1, height: 010,", None),
         ("{tower: 3, height: 1, q: [157.43,", "{tower: 3, height: 1, q: [1:30,",
          "field 'points[2].q[0]' = 1:30 (line 9) is ambiguous: YAML 1.1 reads 1:30 as 90 (a base-60 number)"),
+        ("{tower: 3, height: 1, q: [157.43,", "{tower: 3, height: 1, q: [1_57.43,",
+         "field 'points[2].q[0]' = 1_57.43 (line 9) is ambiguous: YAML 1.1 reads 1_57.43 as 157.43 (its underscores "
+         "dropped as digit separators); write the number itself (157.43) if that is what you mean"),
     ],
-    ids=["pose-on", "octal-height", "sexagesimal-angle"],
+    ids=["pose-on", "octal-height", "sexagesimal-angle", "digit-separators"],
 )
 def test_yaml11_readings_in_a_taught_file_exit_2_quoting_the_source(old: str, new: str, message: str | None,
                                                                       tmp_path: Path,

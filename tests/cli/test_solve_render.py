@@ -86,3 +86,43 @@ def test_the_help_lists_the_video_formats_the_recorder_writes() -> None:
     from ur3hanoi.sim import VIDEO_FORMATS
 
     assert tuple(VIDEO_FORMATS) == VIDEO_EXTENSIONS
+
+
+def test_sigterm_while_rendering_stops_every_process_and_keeps_the_old_video(tmp_path: Path) -> None:
+    """SIGTERM is a Ctrl-C: the run is discarded, the rendering processes and ffmpeg stopped, no semaphore leaked
+    (it ended by the signal's default action, exit -15, and multiprocessing warned of leaked semaphores)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    video = tmp_path / "run.mp4"
+    video.write_bytes(b"the old video")
+    env = dict(os.environ, MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"))
+    proc = subprocess.Popen([sys.executable, "-m", "ur3hanoi.cli", "solve", "--start", "1", "--end", "3", "--video",
+                             str(video)], env=env, text=True, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        assert proc.stderr is not None
+        seen = []
+        for line in proc.stderr:  # progress lines: rendering has started once one counts frames
+            seen.append(line)
+            if "frame" in line:
+                break
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+        deadline = time.monotonic() + 2.0
+        left = True
+        while left and time.monotonic() < deadline:
+            left = subprocess.run(["pgrep", "-s", str(proc.pid)], capture_output=True).returncode == 0
+            time.sleep(0.05)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    err = "".join(seen) + err
+    assert proc.returncode == 143, err
+    assert err.splitlines()[-1] == "ur3hanoi solve: terminated (SIGTERM)" and "leaked" not in err, err
+    assert video.read_bytes() == b"the old video" and [p.name for p in tmp_path.iterdir()] == ["run.mp4"]
+    assert not left, "a process of the run outlived it by 2 s"

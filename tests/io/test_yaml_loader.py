@@ -107,6 +107,8 @@ def test_empty_file_is_none(tmp_path: Path) -> None:
         ("-0_17", -15, "the octal number -15"),
         ("1:30", 90, "90 (a base-60 number)"),
         ("1:30.5", 90.5, "90.5 (a base-60 number)"),
+        ("1_5.7", 15.7, "15.7 (its underscores dropped as digit separators)"),
+        ("1_000", 1000, "1000 (its underscores dropped as digit separators)"),
         ("on", True, "the boolean true"),
         ("Off", False, "the boolean false"),
         ("YES", True, "the boolean true"),
@@ -125,7 +127,8 @@ def test_ambiguous_yaml11_scalars_keep_their_source_text(text: str, value: objec
 @pytest.mark.parametrize(
     ("text", "value"),
     [("'010'", "010"), ('"on"', "on"), ("10", 10), ("0", 0), ("0x10", 16), ("true", True), ("false", False),
-     ("0.5", 0.5), ("007.5", 7.5), ("-1", -1), ("1_000", 1000), ("07", 7), ("00", 0), ("'1:30'", "1:30"), ("y", "y")],
+     ("0.5", 0.5), ("007.5", 7.5), ("-1", -1), ("'1_000'", "1_000"), ("07", 7), ("00", 0), ("'1:30'", "1:30"),
+     ("y", "y")],
 )
 def test_unambiguous_scalars_load_as_before(text: str, value: object) -> None:
     got = parse_yaml(f"a: {text}\n", "f.yaml")["a"]
@@ -145,6 +148,11 @@ _SCHEMA = Record({"n": Field(Number(0, 100, integer=True)), "x": Field(Number(),
         ("n: 1:30", "field 'n' = 1:30 (line 1) is ambiguous: YAML 1.1 reads 1:30 as 90 (a base-60 number); write the "
                     "number itself (90) if that is what you mean"),
         ("n: 5\nx: 1:30.5", "field 'x' = 1:30.5 (line 2) is ambiguous: YAML 1.1 reads 1:30.5 as 90.5"),
+        ("n: 5\nx: 1_5.7", "field 'x' = 1_5.7 (line 2) is ambiguous: YAML 1.1 reads 1_5.7 as 15.7 (its underscores "
+                           "dropped as digit separators); write the number itself (15.7) if that is what you mean"),
+        ("n: 1_0", "field 'n' = 1_0 (line 1) is ambiguous: YAML 1.1 reads 1_0 as 10 (its underscores dropped as "
+                   "digit separators); write the number itself (10) if that is what you mean; expected an integer"),
+        ("n: 5\nname: 1_5.7", "for the text write it in quotes (name: \"1_5.7\")"),
         ("n: on", "field 'n' = on (line 1) is ambiguous: YAML 1.1 reads on as the boolean true; expected an integer"),
         ("n: 5\npose: on", "field 'pose' = on (line 2) is ambiguous: YAML 1.1 reads on as the boolean true; for the "
                            "text write it in quotes (pose: \"on\"); expected one of on, above"),

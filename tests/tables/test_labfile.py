@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 from tests.conftest import LAB_REAL, LAB_SIM, REPO
 from ur3hanoi.cli import main
-from ur3hanoi.errors import OutputError, TableError
+from ur3hanoi.errors import OutputError, TableError, printable
 from ur3hanoi.robot.ik_solvers import pose_errors
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
@@ -566,3 +566,31 @@ def test_every_public_name_resolves_from_its_module() -> None:
     assert set(labfile.__all__) <= set(dir(labfile))
     with pytest.raises(AttributeError, match="no attribute 'nope'"):
         labfile.nope  # noqa: B018
+
+
+@pytest.mark.parametrize(("key", "named"), [("s\u200bim_pos", "U+200B ZERO WIDTH SPACE"),
+                                            ("\u0455im_pos", "U+0455 CYRILLIC SMALL LETTER DZE"),
+                                            ("real_\u00adpos", "U+00AD SOFT HYPHEN"),
+                                            ("\uff53im_pos", "U+FF53 FULLWIDTH LATIN SMALL LETTER S")])
+def test_a_key_that_looks_like_a_known_one_is_warned_about_where_it_is_written_and_read(
+        key: str, named: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The student sees two keys that look alike and does not know why: every write and read that meets the
+    look-alike next to the key it imitates says so, naming the character; the file is written as before."""
+    known = "real_pos" if key.startswith("real") else "sim_pos"
+    cal = "lab_real" if known == "real_pos" else "lab_sim"
+    path = tmp_path / "lab2_data.yaml"
+    path.write_text(f"{key}: [mine]\n", encoding="utf-8")
+    for _ in range(2):  # the second run writes the same bytes back: the warning comes again
+        assert main(["tables", cal, "--key", known, "-o", str(path)]) == 0
+        err = capsys.readouterr().err
+        assert err.splitlines() == [f"ur3hanoi: warning: {path}: key '{printable(key)}' looks like '{known}' but is "
+                                    f"another key (it has {named}): ur3hanoi reads and writes '{known}' only; rename "
+                                    "or delete the look-alike"], err
+    data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    assert data[key] == ["mine"] and known in data
+    assert main(["check-table", str(path), "--key", known, "--calibration", cal]) == 0
+    assert f"looks like '{known}'" in capsys.readouterr().err
+    plain = tmp_path / "plain.yaml"
+    plain.write_text("sim_pos_mine: 1\nreal: 2\n")
+    assert main(["tables", "lab_sim", "--key", "sim_pos", "-o", str(plain)]) == 0
+    assert "warning" not in capsys.readouterr().err

@@ -7,6 +7,7 @@
 3     suction fault in ``solve`` (halted: suction off, arm at home)
 70    internal error (a bug: rerun with ``--debug`` for the traceback)
 130   interrupted (Ctrl-C)
+143   terminated (SIGTERM: the same clean-up as a Ctrl-C)
 141   standard output closed early (e.g. piped into ``head``)
 ====  ==========================================================================================
 """
@@ -21,6 +22,7 @@ BAD_INPUT = 2
 SUCTION_FAULT = 3
 INTERNAL = 70
 INTERRUPTED = 130
+TERMINATED = 143
 BROKEN_PIPE = 141
 
 EXIT_CODES: tuple[tuple[type[Ur3HanoiError], int], ...] = (

@@ -3,8 +3,9 @@
 A library error (:class:`~ur3hanoi.errors.Ur3HanoiError`) prints ``ur3hanoi: error: <message>`` and exits with the
 code of :data:`ur3hanoi.cli.exit_codes.EXIT_CODES`; a bad option prints ``ur3hanoi: error: argument ... (see
 ur3hanoi <command> --help)`` and exits 2; anything unexpected prints ``ur3hanoi: error: internal error in ur3hanoi
-<command>: ...`` and exits 70, and
-``--debug`` shows its traceback instead.
+<command>: ...`` and exits 70, and ``--debug`` shows its traceback instead. SIGTERM is handled like a Ctrl-C (the
+same clean-up: child processes stopped, an old output kept; :func:`ur3hanoi.lifecycle.sigterm_raises`) and exits
+143. A library warning (:class:`~ur3hanoi.errors.Ur3HanoiWarning`) prints ``ur3hanoi: warning: <message>``.
 """
 
 from __future__ import annotations
@@ -13,12 +14,14 @@ import argparse
 import importlib
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 from typing import NoReturn
 
 from ur3hanoi import __version__
 from ur3hanoi.cli import exit_codes
-from ur3hanoi.errors import Ur3HanoiError, printable
+from ur3hanoi.errors import Ur3HanoiError, Ur3HanoiWarning, printable
+from ur3hanoi.lifecycle import Terminated, sigterm_raises
 
 COMMAND_MODULES: dict[str, str] = {
     "tables": "tables", "check-table": "check_table", "calibrate": "calibrate", "teach": "teach", "plan": "plan",
@@ -78,6 +81,15 @@ def help_markdown(width: int = 100) -> str:
     return "\n".join(parts) + "\n"
 
 
+def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                  file: object = None, line: str | None = None) -> None:
+    """``ur3hanoi: warning: <message>`` for a library warning, Python's own format for any other."""
+    if issubclass(category, Ur3HanoiWarning):
+        print(f"ur3hanoi: warning: {_one_line(message)}", file=sys.stderr)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
 def _exit_status(code: object) -> int:
     if code is None:
         return exit_codes.OK
@@ -100,10 +112,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _exit_status(exc.code)
     prog = f"ur3hanoi {args.command}"
     try:
-        return int(args.func(args))
+        with sigterm_raises(), warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            return int(args.func(args))
     except Ur3HanoiError as exc:
         print(f"{ERROR_PREFIX} {_one_line(exc)}", file=sys.stderr)
         return exit_codes.exit_code_for(exc)
+    except Terminated:
+        print(f"{prog}: terminated (SIGTERM)", file=sys.stderr)
+        return exit_codes.TERMINATED
     except KeyboardInterrupt:
         print(f"{prog}: interrupted", file=sys.stderr)
         return exit_codes.INTERRUPTED

@@ -7,6 +7,11 @@ llvmpipe limited to one thread) builds the same task scene and renders the joint
 :class:`ur3hanoi.sim.OffscreenRecorder`; while it is busy, offered states are dropped. A video therefore has the
 frames the machine could render (a few per second with software GL) and plays faster than real time; the control
 loop keeps real time.
+
+The child ignores SIGINT (a Ctrl-C reaches the whole foreground group: the station, not the child, decides when the
+video ends) and stops on SIGTERM or when the station dies (``PR_SET_PDEATHSIG``, or the end of file of its pipe):
+then it discards what it rendered, so an existing video or frames folder stays as it was
+(:func:`ur3hanoi.lifecycle.child_start`).
 """
 
 from __future__ import annotations
@@ -22,8 +27,20 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.interface.errors import RosError
 
 
-def _worker(conn: Connection, calibration: str, n_blocks: int, frames: Path | None, video: Path | None) -> None:
+class _StoppedError(Exception):
+    """SIGTERM, or the station died: discard the output and exit."""
+
+
+def _stopped(_signum: int, _frame: object) -> None:
+    raise _StoppedError
+
+
+def _worker(parent: int, conn: Connection, calibration: str, n_blocks: int, frames: Path | None,
+            video: Path | None) -> None:
+    from ur3hanoi.lifecycle import child_start
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the station stops us (a Ctrl-C must not cut the video short)
+    child_start(parent)  # SIGTERM at its default until the recorder exists: nothing to discard before
     os.environ.setdefault("LP_NUM_THREADS", "1")  # llvmpipe: leave the other core to the control loop
     os.environ.setdefault("MUJOCO_GL", "egl")
     os.nice(10)
@@ -39,8 +56,9 @@ def _worker(conn: Connection, calibration: str, n_blocks: int, frames: Path | No
     except Exception as exc:  # reported to the station, which raises it as one line
         conn.send(f"error: {' '.join(str(exc).split())}")
         return
-    conn.send(f"ready {recorder.fps}")
+    signal.signal(signal.SIGTERM, _stopped)
     try:
+        conn.send(f"ready {recorder.fps}")
         while True:
             qpos = conn.recv()
             if qpos is None:
@@ -49,9 +67,14 @@ def _worker(conn: Connection, calibration: str, n_blocks: int, frames: Path | No
             mujoco.mj_forward(scene.model, scene.data)
             recorder(scene.model, scene.data)
             conn.send(recorder.count)
-    finally:
+    except BaseException as exc:  # no half-written output, whatever stopped the loop
+        recorder.discard()
         recorder.close()
-        conn.send("closed")
+        if isinstance(exc, _StoppedError | EOFError | OSError):
+            return  # SIGTERM, or the station is gone
+        raise
+    recorder.close()
+    conn.send("closed")
 
 
 class FrameProcess:
@@ -66,7 +89,7 @@ class FrameProcess:
                  start_timeout_s: float = 120.0) -> None:
         ctx = multiprocessing.get_context("spawn")  # never fork a process that runs rospy's or DDS threads
         self._conn, child = ctx.Pipe()
-        self._proc: Any = ctx.Process(target=_worker, args=(child, calibration, n_blocks, frames, video),
+        self._proc: Any = ctx.Process(target=_worker, args=(os.getpid(), child, calibration, n_blocks, frames, video),
                                       daemon=True, name="ur3hanoi-render")
         self._proc.start()
         child.close()

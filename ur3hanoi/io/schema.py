@@ -18,7 +18,7 @@ from typing import Any
 from ur3hanoi.errors import MISSING, InputError, printable, quote
 from ur3hanoi.io.limits import MAX_LIST_ITEMS
 from ur3hanoi.io.number import Number as Number  # re-exported: a schema field's range is a Number
-from ur3hanoi.io.yaml11 import Yaml11Reading
+from ur3hanoi.io.yaml11 import OCTAL, Yaml11Reading
 
 
 @dataclass(frozen=True)
@@ -140,8 +140,8 @@ class _Validator:
         return self.error.invalid(self.source, path, value, allowed)
 
     def ambiguous(self, path: str, value: Yaml11Reading, spec: Spec) -> InputError:
-        """``010``, ``1:30``, ``on`` where the schema expects a number or a name: quote the source, say how to
-        write it."""
+        """``010``, ``1:30``, ``1_5.7``, ``on`` where the schema expects a number or a name: quote the source, say
+        how to write it."""
         while isinstance(spec, Nullable):
             spec = spec.item
         said = f"YAML 1.1 reads {value.text} as {value.meaning}"
@@ -149,7 +149,7 @@ class _Validator:
             leaf = path.rsplit(".", 1)[-1] if path and not path.endswith("]") else ""
             how = f"{leaf}: \"{value.text}\"" if leaf else f"\"{value.text}\""
             allowed = f"{said}; for the text write it in quotes ({how}); expected {spec.expected()}"
-        elif isinstance(spec, Number) and ":" in value.text:
+        elif isinstance(spec, Number) and not isinstance(value.value, bool) and not value.meaning.startswith(OCTAL):
             allowed = f"{said}; write the number itself ({value.value}) if that is what you mean; expected " \
                       f"{spec.expected()}"
         elif isinstance(spec, Number) and not isinstance(value.value, bool):

@@ -6,6 +6,10 @@ from __future__ import annotations
 
 from typing import Any
 
+OCTAL = "the octal number"
+"""How a :class:`Yaml11Reading`'s ``meaning`` starts for an octal integer (``010``: "the octal number 8"); the
+schema's advice differs for it (write 10 or 8, whichever you mean)."""
+
 
 class Yaml11Reading:
     """A plain scalar YAML 1.1 reads as something else than it looks: ``text`` as written, ``value`` the YAML 1.1

@@ -13,11 +13,12 @@ On top of PyYAML's ``SafeLoader`` (no Python objects) it refuses, with one line 
   (see :mod:`ur3hanoi.io.reading`).
 
 YAML 1.1 (what PyYAML implements) reads a few plain scalars as something other than what they look like:
-``010`` is the octal number 8, ``1:30`` is 90 (base 60), and unquoted ``on``/``off``/``yes``/``no`` are
-booleans. The loader keeps such a scalar as a :class:`Yaml11Reading` (its source text, the YAML 1.1 value and
-what that value means) instead of the silent value, and the schema validator (:mod:`ur3hanoi.io.schema`) refuses
-it wherever a number or a name is expected, quoting the source text and how to write it (``pose: "on"``). Where a
-file holds free-form data (a student's own keys in a lab table), it stays as it is.
+``010`` is the octal number 8, ``1:30`` is 90 (base 60), ``1_5.7`` is 15.7 (underscores are digit separators, so
+``1_000`` is 1000; YAML 1.2 reads both as text), and unquoted ``on``/``off``/``yes``/``no`` are booleans. The
+loader keeps such a scalar as a :class:`Yaml11Reading` (its source text, the YAML 1.1 value and what that value
+means) instead of the silent value, and the schema validator (:mod:`ur3hanoi.io.schema`) refuses it wherever a
+number or a name is expected, quoting the source text and how to write it (``pose: "on"``). Where a file holds
+free-form data (a student's own keys in a lab table), it stays as it is.
 """
 
 from __future__ import annotations
@@ -34,12 +35,13 @@ from yaml.nodes import MappingNode, Node, ScalarNode
 from ur3hanoi.errors import InputError, printable, quote
 from ur3hanoi.io.limits import MAX_ALIASES, MAX_DEPTH, MAX_INT_DIGITS, MAX_NODES
 from ur3hanoi.io.reading import read_input_bytes
-from ur3hanoi.io.yaml11 import Yaml11Reading
+from ur3hanoi.io.yaml11 import OCTAL, Yaml11Reading
 
 _MERGE_TAG = "tag:yaml.org,2002:merge"
 
 
 _YAML11_BOOLS = frozenset({"yes", "no", "on", "off"})
+_SEPARATORS = "(its underscores dropped as digit separators)"
 
 
 def _octal(text: str) -> bool:
@@ -86,15 +88,20 @@ class StrictConstructor(SafeConstructor):
             raise YamlLimitError(problem=f"integer longer than {MAX_INT_DIGITS} digits", problem_mark=node.start_mark)
         value: int = super().construct_yaml_int(node)
         if _plain(node) and _octal(text) and int(text.replace("_", ""), 10) != value:
-            return Yaml11Reading(text, value, f"the octal number {value}", node.start_mark.line + 1)
+            return Yaml11Reading(text, value, f"{OCTAL} {value}", node.start_mark.line + 1)
         if _plain(node) and ":" in text:
             return Yaml11Reading(text, value, f"{value} (a base-60 number)", node.start_mark.line + 1)
+        if _plain(node) and "_" in text:
+            return Yaml11Reading(text, value, f"{value} {_SEPARATORS}", node.start_mark.line + 1)
         return value
 
     def construct_yaml_float(self, node: ScalarNode) -> float | Yaml11Reading:  # type: ignore[override]
         value: float = super().construct_yaml_float(node)
-        if _plain(node) and ":" in str(node.value):
-            return Yaml11Reading(str(node.value), value, f"{value:g} (a base-60 number)", node.start_mark.line + 1)
+        text = str(node.value)
+        if _plain(node) and ":" in text:
+            return Yaml11Reading(text, value, f"{value:g} (a base-60 number)", node.start_mark.line + 1)
+        if _plain(node) and "_" in text:
+            return Yaml11Reading(text, value, f"{value!r} {_SEPARATORS}", node.start_mark.line + 1)
         return value
 
     def construct_yaml_bool(self, node: ScalarNode) -> bool | Yaml11Reading:  # type: ignore[override]

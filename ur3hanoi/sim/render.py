@@ -20,6 +20,7 @@ import contextlib
 import math
 import os
 import re
+import signal
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -153,7 +154,11 @@ def _draw(renderer: mujoco.Renderer, data: mujoco.MjData, camera: mujoco.MjvCame
 _WORKER: dict[str, Any] = {}
 
 
-def _init_worker(model: mujoco.MjModel, lookat: tuple[float, float, float], cam: CameraConfig) -> None:
+def _init_worker(parent: int, model: mujoco.MjModel, lookat: tuple[float, float, float], cam: CameraConfig) -> None:
+    from ur3hanoi.lifecycle import child_start
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent terminates the pool (SIGTERM) on a Ctrl-C
+    child_start(parent)  # and the kernel does when the parent dies
     # One llvmpipe thread per process: the processes are the parallelism (read when the GL driver loads).
     os.environ.setdefault("LP_NUM_THREADS", "1")
     _WORKER["model"], _WORKER["data"] = model, mujoco.MjData(model)
@@ -244,7 +249,7 @@ class OffscreenRecorder:
             import multiprocessing
 
             ctx = multiprocessing.get_context("spawn")  # a fresh GL context per process, nothing inherited
-            self._pool = ctx.Pool(self.workers, initializer=_init_worker, initargs=(model, self.lookat, cam))
+            self._pool = ctx.Pool(self.workers, _init_worker, (os.getpid(), model, self.lookat, cam))
 
     def _open_writer(self) -> Any:
         """Start ffmpeg on the first frame: a run with no frame in the window leaves no (invalid) video behind."""

@@ -2,14 +2,23 @@
 
 What every reader and the writer share; NumPy-free (and PyYAML is imported when a file is parsed).
 Checking a key's value is :mod:`~ur3hanoi.tables.read`'s.
+
+A key that is not one of :data:`KNOWN_KEYS` but reads as one once its invisible characters are taken out and its
+look-alike letters read as the Latin ones (``s\u200bim_pos`` with a zero-width space, ``ѕim_pos`` with a Cyrillic
+``ѕ``: :func:`confusable_keys`) is the student's own key to ur3hanoi, and a second ``sim_pos`` next to it looks
+like the same key twice. Reading a file that has both, or writing the key it imitates, warns, naming the characters
+(:class:`~ur3hanoi.errors.Ur3HanoiWarning`).
 """
 
 from __future__ import annotations
 
+import unicodedata
+import warnings
+from collections.abc import Collection
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from ur3hanoi.errors import TableError, quote
+from ur3hanoi.errors import TableError, Ur3HanoiWarning, printable, quote
 from ur3hanoi.io.reading import read_input_bytes
 
 TABLE_KEYS: tuple[str, ...] = ("sim_pos", "real_pos")
@@ -20,6 +29,39 @@ WHAT = "lab table file"
 """How messages name the file kind."""
 KNOWN_KEYS: tuple[str, ...] = (*TABLE_KEYS, BLOCK_XY_KEY)
 """ur3hanoi's keys (those of :data:`ur3hanoi.tables.read.LAB_FILE_SCHEMA`); any other key is the student's."""
+
+
+_LOOK_ALIKE = str.maketrans("аеорсхуѕіјԁοιɑℓ", "aeopcxysijdoial")
+"""Cyrillic and Greek letters (and a few Latin ones) drawn like the Latin letters of ur3hanoi's keys."""
+_UNSEEN = frozenset({"Cf", "Cc", "Mn", "Me", "Zs", "Zl", "Zp"})
+"""Unicode categories taken out of a key before comparing it: format (zero-width, bidi), control, combining marks,
+spaces."""
+
+
+def _skeleton(key: str) -> str:
+    """``key`` as a reader sees it: compatibility forms folded (full-width letters), invisible characters and
+    combining marks taken out, look-alike letters read as Latin ones."""
+    text = unicodedata.normalize("NFD", unicodedata.normalize("NFKC", key))
+    return "".join(c for c in text if unicodedata.category(c) not in _UNSEEN).translate(_LOOK_ALIKE)
+
+
+def confusable_keys(data: dict[Any, Any]) -> list[tuple[str, str]]:
+    """``(key, known)`` for each key of ``data`` that is not one of :data:`KNOWN_KEYS` but reads as ``known``."""
+    return [(k, known) for k in data if isinstance(k, str) and k not in KNOWN_KEYS
+            for known in KNOWN_KEYS if _skeleton(k) == known]
+
+
+def warn_confusable(data: dict[Any, Any], source: str, twins: Collection[str]) -> bool:
+    """Warn about each key of ``data`` that reads as a known key in ``twins`` (the keys present, or the keys about to
+    be written); True if ``data`` has any key that reads as a known one."""
+    found = confusable_keys(data)
+    for key, known in found:
+        if known in twins:
+            odd = ", ".join(dict.fromkeys(f"U+{ord(c):04X} {unicodedata.name(c, '?')}" for c in key if not c.isascii()))
+            warnings.warn(Ur3HanoiWarning(
+                f"{printable(source)}: key '{printable(key, 60)}' looks like '{known}' but is another key (it has "
+                f"{odd}): ur3hanoi reads and writes '{known}' only; rename or delete the look-alike"), stacklevel=2)
+    return bool(found)
 
 
 class LabFile(NamedTuple):
@@ -60,6 +102,7 @@ def parse_lab_file(raw: bytes, source: str) -> LabFile:
 
         raise TableError.file(source, f"the top level is {describe_type(data)}, not a mapping of keys "
                                       f"({', '.join(KNOWN_KEYS)}, or your own): not a {WHAT}")
+    warn_confusable(data, source, data)
     return LabFile(data=data, text=doc.text, sha256=doc.sha256, bom=doc.bom)
 
 
@@ -69,5 +112,5 @@ def check_key(key: str) -> None:
         raise TableError(f"table key {quote(key)} is invalid: expected one of {', '.join(TABLE_KEYS)}")
 
 
-__all__ = ["BLOCK_XY_KEY", "KNOWN_KEYS", "TABLE_KEYS", "WHAT", "LabFile", "check_key", "parse_lab_file",
-           "read_lab_file"]
+__all__ = ["BLOCK_XY_KEY", "KNOWN_KEYS", "TABLE_KEYS", "WHAT", "LabFile", "check_key", "confusable_keys",
+           "parse_lab_file", "read_lab_file", "warn_confusable"]

@@ -18,7 +18,7 @@ from typing import Any
 from ur3hanoi.errors import TableError, printable
 from ur3hanoi.io.atomic import locked_output
 from ur3hanoi.io.reading import read_input_bytes
-from ur3hanoi.tables.file import WHAT, LabFile, check_key, parse_lab_file
+from ur3hanoi.tables.file import WHAT, LabFile, check_key, parse_lab_file, warn_confusable
 from ur3hanoi.tables.format import ANGLE_DECIMALS
 from ur3hanoi.tables.sections import Sections
 
@@ -49,6 +49,8 @@ def write_sections(path: str | Path, sections: Sections, inputs: Sequence[str | 
         from ur3hanoi.tables.splice import splice_yaml
 
         old = parse_lab_file(raw, out.shown) if raw is not None else LabFile(data={}, text="", sha256="")
+        # A look-alike of a key written is warned about (one of a key present, by parse_lab_file already).
+        warn_confusable(old.data, out.shown, [k for k in sections.text if k not in old.data])
         try:
             text = splice_yaml(old.text, sections.text, sections.headers, sections.values)
         except TableError as exc:

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import socket
 import subprocess
+import sys
+import threading
 import time
 
 import pytest
@@ -112,3 +115,67 @@ def test_the_guard_stops_the_master_and_removes_its_logs_on_sigterm_too(tmp_path
             os.kill(pid, 0)
     finally:
         core.stop()
+
+
+@pytest.mark.ros
+@requires_ros
+def test_the_master_the_guard_starts_obeys_sigint_and_the_guard_stops_on_sigint(tmp_path, monkeypatch):
+    """The guard's rosmaster starts with SIGINT at its default (it inherited the guard's ignored SIGINT across exec,
+    and every stop waited 15 s for a SIGKILL): a SIGINT stops it at once. A SIGINT to the guard stops it cleanly."""
+    env = ros_env(free_port(), tmp_path)
+    monkeypatch.setenv("ROS_HOME", env["ROS_HOME"])
+    uri = env["ROS_MASTER_URI"]
+    core = RosCore(uri)
+    try:
+        core.start()
+        pid, guard = master_pid(uri), core.guard_pid
+        assert pid is not None and guard is not None
+        os.kill(pid, signal.SIGINT)
+        deadline = time.monotonic() + 2.0
+        while alive(pid) and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert not alive(pid) and not master_answers(uri), "rosmaster ignored SIGINT"
+        assert alive(guard)  # it reports the exit and waits for its station
+        os.kill(guard, signal.SIGINT)
+        deadline = time.monotonic() + 2.0
+        while alive(guard) and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert not alive(guard) and core.log_dir is not None and not core.log_dir.exists()
+    finally:
+        core.stop()
+
+
+@pytest.mark.ros
+@requires_ros
+def test_a_master_whose_station_died_is_waited_out_not_attached_to(tmp_path, monkeypatch):
+    """A station's master outlives it for a moment (its guard is stopping it; here the guard is held with SIGSTOP
+    for 1 s): a RosCore started on the same URI meanwhile waits until it is gone and starts its own, instead of
+    attaching to a master that vanishes a moment later."""
+    env = ros_env(free_port(), tmp_path)
+    monkeypatch.setenv("ROS_HOME", env["ROS_HOME"])
+    uri = env["ROS_MASTER_URI"]
+    code = ("import sys, time\nfrom ur3hanoi.interface.ros1.master import RosCore\n"
+            f"c = RosCore({uri!r}).start()\nprint(c.guard_pid, flush=True)\ntime.sleep(60)\n")
+    crashed = subprocess.Popen([sys.executable, "-c", code], env=env, text=True, stdout=subprocess.PIPE,
+                               start_new_session=True)
+    core, guard = RosCore(uri), 0
+    try:
+        assert crashed.stdout is not None
+        guard = int(crashed.stdout.readline())
+        old = master_pid(uri)
+        assert old is not None
+        os.kill(guard, signal.SIGSTOP)
+        os.kill(crashed.pid, signal.SIGKILL)
+        crashed.wait()
+        threading.Timer(1.0, os.kill, (guard, signal.SIGCONT)).start()
+        t0 = time.monotonic()
+        core.start()
+        assert core.started and time.monotonic() - t0 >= 1.0
+        assert master_pid(uri) not in (None, old) and not alive(old) and not alive(guard)
+    finally:
+        if guard:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(guard, signal.SIGCONT)
+        core.stop()
+        if crashed.poll() is None:
+            crashed.kill()

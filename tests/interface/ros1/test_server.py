@@ -12,6 +12,7 @@ import socket
 import subprocess
 import sys
 import time
+import xmlrpc.client
 from pathlib import Path
 
 import pytest
@@ -31,7 +32,7 @@ from tests.support.ros_support import (
     station,
     ur3hanoi_cmd,
 )
-from ur3hanoi.interface.ros1.master import master_answers
+from ur3hanoi.interface.ros1.master import master_answers, master_pid, node_registered
 from ur3hanoi.station.calibration import load_station
 
 pytestmark = [pytest.mark.ros, requires_ros]
@@ -248,3 +249,124 @@ def test_standard_output_carries_only_the_json_report(tmp_path):
     assert [s["tower"] for s in report["spawns"]] == [1, 2]
     err = "".join(st.stderr)
     assert "ur3hanoi ros-station: ready" in err and "ur3hanoi/spawn: 3 blocks respawned on tower 2" in err
+
+
+def _gone_within(pids: set[int], timeout_s: float) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while any(alive(p) for p in pids) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    return not any(alive(p) for p in pids)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_station_with_its_own_master_stops_within_2_s(tmp_path, sig):
+    """Every stop took 15-17 s: the guard's rosmaster ignored the guard's SIGINTs until its SIGKILL."""
+    env = ros_env(free_port(), tmp_path)
+    uri = env["ROS_MASTER_URI"]
+    with station(env, tmp_path) as st:
+        below = descendants(st.proc.pid)
+        assert len(below) >= 2  # the guard and rosmaster
+        t0 = time.monotonic()
+        st.proc.send_signal(sig)
+        code = st.proc.wait(timeout=30)
+        took = time.monotonic() - t0
+        assert code == 0 and took < 2.0, f"{sig.name}: exit {code} after {took:.1f} s:\n{st.log()}"
+        assert _gone_within(below, 0.1) and not master_answers(uri)
+    report = st.read_report()
+    assert report["roscore_started"] and report["master_events"] == []
+
+
+def test_a_station_restarted_right_after_a_sigkill_has_a_master_of_its_own(tmp_path):
+    """After a SIGKILL of a station its master lingered 15 s: a station started on the same URI meanwhile attached
+    to it, and was left without a master when the old guard killed it."""
+    env = ros_env(free_port(), tmp_path)
+    uri = env["ROS_MASTER_URI"]
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    with station(env, tmp_path / "a") as first:
+        below = descendants(first.proc.pid)
+        os.kill(first.proc.pid, signal.SIGKILL)
+        t0 = time.monotonic()
+        with station(env, tmp_path / "b") as second:
+            assert _gone_within(below, max(0.1, t0 + 2.0 - time.monotonic())), "the old master outlived 2 s"
+            time.sleep(0.5)
+            snap = second.snapshot()
+            assert snap["roscore_started"], "attached to the old station's master"
+            assert master_pid(uri) in descendants(second.proc.pid)
+            assert node_registered(uri, "/ur3hanoi_station")
+            report = second.stop()
+    assert report["master_events"] == [] and not master_answers(uri)
+
+
+def _wait_line(st: Station, text: str, timeout_s: float) -> float | None:
+    """Seconds until a line of the station's stderr contains ``text``, None after ``timeout_s``."""
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout_s:
+        if any(text in line for line in st.stderr):
+            return time.monotonic() - t0
+        time.sleep(0.02)
+    return None
+
+
+def _solve(env: dict[str, str]) -> subprocess.Popen[str]:
+    """``ros-solve 1 -> 3`` started, once it has said it is connected."""
+    solve = subprocess.Popen(ur3hanoi_cmd("ros-solve", "--start", "1", "--end", "3"), env=env, text=True,
+                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             start_new_session=True)
+    assert solve.stdout is not None and "connected to" in solve.stdout.readline()
+    return solve
+
+
+def test_its_own_master_killed_under_a_running_station_is_started_again_and_ros_solve_stops(tmp_path):
+    """The station says so within 2 s, starts its master again and registers with it (a node started now finds
+    it). ros-solve, whose master is gone, exits 2 with one line although the station still publishes."""
+    env = ros_env(free_port(), tmp_path)
+    uri = env["ROS_MASTER_URI"]
+    port = uri.rsplit(":", 1)[1]
+    with station(env, tmp_path) as st:
+        solve = _solve(env)
+        try:
+            old = master_pid(uri)
+            assert old is not None
+            os.kill(old, signal.SIGKILL)
+            said = _wait_line(st, f"the ROS master at {uri} is gone (nothing listens on port {port} any more)", 2.0)
+            assert said is not None, f"nothing said within 2 s:\n{st.log()}"
+            assert _wait_line(st, "started the ROS master again", 10.0) is not None, st.log()
+            _, err = solve.communicate(timeout=30)
+        finally:
+            if solve.poll() is None:
+                os.killpg(solve.pid, signal.SIGKILL)
+        new = master_pid(uri)
+        assert new not in (None, old) and new in descendants(st.proc.pid)
+        # A node started now finds the station: the new master knows its topics.
+        publishers, subscribers, _ = xmlrpc.client.ServerProxy(uri).getSystemState("/probe")[2]
+        assert ["/ur3/position", ["/ur3hanoi_station"]] in publishers
+        assert ["/ur3/command", ["/ur3hanoi_station"]] in subscribers
+        report = st.stop()
+    assert [e["event"] for e in report["master_events"]] == ["lost", "restarted"]
+    assert report["master_events"][1]["pid"] == new and report["roscore_started"]
+    assert not master_answers(uri) and not alive(new)
+    assert solve.returncode == 2, err
+    assert err.splitlines() == [f"ur3hanoi: error: the ROS master at {uri} is gone (nothing listens on port {port} "
+                                "any more): ros-solve stops; is the station (or roscore) still running?"], err
+
+
+def test_a_master_the_station_did_not_start_vanishing_stops_it_with_one_line(tmp_path):
+    env = ros_env(free_port(), tmp_path)
+    uri = env["ROS_MASTER_URI"]
+    port = uri.rsplit(":", 1)[1]
+    with roscore(env):
+        master = master_pid(uri)
+        assert master is not None
+        with station(env, tmp_path) as st:
+            os.kill(master, signal.SIGKILL)
+            t0 = time.monotonic()
+            code = st.proc.wait(timeout=30)
+            took = time.monotonic() - t0
+            st.kill()
+    said = [line.rstrip("\n") for line in st.stderr if not line.startswith("ur3hanoi ros-station: ready")]
+    assert code == 2 and took < 2.0, f"exit {code} after {took:.1f} s:\n{st.log()}"
+    assert said == [f"ur3hanoi: error: the ROS master at {uri} is gone (nothing listens on port {port} any more); the "
+                    "station did not start it, so it stops: start the master again, then the station"], st.log()
+    report = st.read_report()
+    assert not report["roscore_started"] and [e["event"] for e in report["master_events"]] == ["lost"]

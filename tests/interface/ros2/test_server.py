@@ -16,7 +16,7 @@ import pytest
 
 from tests.support import REPO, SUPPORT
 from tests.support.ros2_support import in_netns, requires_netns
-from ur3hanoi.interface.ros2.dds import cyclone_config
+from ur3hanoi.interface.ros2.dds import LEASE_DURATION_S, cyclone_config
 from ur3hanoi.interface.ros2.server import BRIDGE_MOVE_S, Ros2Station, Ros2StationOptions, bridge_speed
 from ur3hanoi.robot.movej import plan_movej
 from ur3hanoi.station.calibration import load_station
@@ -340,3 +340,42 @@ kill -INT $ST; wait $ST; echo "station exit $?" >&2
     assert min(im.std() for im in images) > 5.0 and min(colours) > 50, colours  # not blank: a rendered scene
     assert max(float(np.abs(im - images[0]).max()) for im in images) > 50.0
     assert _left_running(report) == []
+
+
+# ------------------------------------------------------------------------------- stopping, crashing, restarting
+
+PROBE = f"{sys.executable} {SUPPORT / 'ros2_lifecycle_probe.py'}"
+
+
+def test_the_participant_lease_is_short() -> None:
+    for network in ("loopback", "lab", "eth0"):
+        assert f"<LeaseDuration>{LEASE_DURATION_S} s</LeaseDuration>" in cyclone_config(network)
+    assert LEASE_DURATION_S <= 3
+
+
+@pytest.mark.dds
+@requires_netns
+def test_a_station_restarted_right_after_a_sigkill_is_alone_in_the_graph_within_the_lease(tmp_path: Path) -> None:
+    """The dead station's participant (a ghost: a second ur3hanoi_station, a reader that never reads) stayed in its
+    peers' graph for Cyclone's default 10 s lease; the new station publishes at once and stops within 2 s."""
+    result = in_netns(f"{PROBE} restart {tmp_path}", 180.0, REPO)
+    assert result.returncode == 0, result.stdout + result.stderr
+    got = json.loads(result.stdout.strip().splitlines()[-1])
+    assert got["ghost_s"] is not None and got["ghost_s"] < LEASE_DURATION_S + 1.5, got
+    assert got["others_after"] == 1 and got["positions"], got
+    assert got["exit"] == 0 and got["stop_s"] < 2.0, got
+
+
+@pytest.mark.dds
+@requires_netns
+def test_a_rendering_station_stops_within_2_s_and_its_sigkill_leaves_the_old_video_and_no_process(
+        tmp_path: Path) -> None:
+    """SIGINT: the video is finished and the rendering process stopped within 2 s. SIGKILL: the rendering process
+    (it used to finish and put the half video in place of the old one) discards it and is gone within 2 s."""
+    result = in_netns(f"{PROBE} video {tmp_path}", 240.0, REPO)
+    assert result.returncode == 0, result.stdout + result.stderr
+    got = json.loads(result.stdout.strip().splitlines()[-1])
+    assert got["sigint_exit"] == 0 and got["sigint_s"] < 2.0 and got["sigint_written"], got
+    assert got["sigint_left"] == [], got
+    assert got["renderers"] >= 1 and got["renderer_gone_s"] is not None and got["renderer_gone_s"] < 2.0, got
+    assert got["kept"] and got["files"] == ["out.mp4"] and "Traceback" not in got["errors"], got

@@ -2,7 +2,9 @@
 
 :class:`RosArm` is the transport-neutral :class:`ur3hanoi.interface.client.TopicArm` (moves, waits, suction checks,
 timeouts) bound to rospy: it registers with the master and waits for the driver before the first command (a rospy
-publisher drops messages until a subscriber is connected); the callbacks run in rospy's threads.
+publisher drops messages until a subscriber is connected); the callbacks run in rospy's threads. The master is
+watched (:class:`~ur3hanoi.interface.ros1.watch.MasterWatch`): once it is gone, the next wait raises :class:`RosError`
+(one line, exit 2), as when the positions stop.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ class RosArm(TopicArm):
         self._rospy: Any = None
         self._msgs: Any = None
         self._pub: Any = None
+        self._watch: Any = None  # the MasterWatch once connected
 
     # --------------------------------------------------------------------------------------------- callbacks
     def _on_position(self, msg: Any) -> None:
@@ -55,20 +58,24 @@ class RosArm(TopicArm):
             RosError: no master, or the driver's topics do not appear within ``connect_timeout_s``.
         """
         from ur3hanoi.interface.ros1.env import import_rospy
-        from ur3hanoi.interface.ros1.master import MasterUri, master_answers
+        from ur3hanoi.interface.ros1.master import MasterUri, master_pid
         from ur3hanoi.interface.ros1.msgs import load_messages
+        from ur3hanoi.interface.ros1.watch import MasterWatch, quick_shutdown
 
         MasterUri.parse(self.master_uri)
-        if not master_answers(self.master_uri, timeout=2.0):
+        pid = master_pid(self.master_uri, timeout=2.0)
+        if pid is None:
             raise RosError(f"no ROS master answers at {self.master_uri}: start `ur3hanoi ros-station` (it starts one) "
                            "or the course's ur3_driver, or set ROS_MASTER_URI")
         self._msgs = msgs = load_messages()
         rospy = self._rospy = import_rospy()
         os.environ["ROS_MASTER_URI"] = self.master_uri
         rospy.init_node("ur3hanoi_solve", anonymous=True, argv=[sys.argv[0]], disable_signals=True)
+        quick_shutdown()
         self._pub = rospy.Publisher("/ur3/command", msgs.command, queue_size=10)
         rospy.Subscriber("/ur3/position", msgs.position, self._on_position, tcp_nodelay=True)
         rospy.Subscriber("/ur3/gripper_input", msgs.gripper_input, self._on_gripper, tcp_nodelay=True)
+        self._watch = MasterWatch(self.master_uri, pid).start()
         self._await_driver(self.master_uri, "ros-station or the course's ur3_driver")
 
     def simulated(self) -> bool:
@@ -79,9 +86,23 @@ class RosArm(TopicArm):
         return node_registered(self.master_uri, f"/{NODE_NAME}")
 
     def close(self) -> None:
-        """Unregister the node."""
+        """Stop watching the master and unregister the node (not with a master that is gone)."""
+        from ur3hanoi.interface.ros1.watch import forget_master
+
+        watch, self._watch = self._watch, None
+        if watch is not None:
+            watch.stop()
+            if watch.lost is not None:
+                forget_master()
         if self._rospy is not None:
             self._rospy.signal_shutdown("ur3hanoi ros-solve done")
+
+    def _poll(self) -> None:
+        """Raise once the master is gone (the callbacks themselves run in rospy's threads)."""
+        lost = None if self._watch is None else self._watch.lost
+        if lost is not None:
+            raise RosError(f"the ROS master at {self.master_uri} is gone ({lost}): ros-solve stops; is the station "
+                           "(or roscore) still running?")
 
     # ---------------------------------------------------------------------------------------------- transport
     def _subscribed(self) -> bool:

@@ -6,12 +6,14 @@ station holds. The guard
 
 - becomes a child subreaper (``PR_SET_CHILD_SUBREAPER``): the nodes roscore launches (rosmaster, rosout; roslaunch
   puts each in its own session) are re-parented to the guard if roscore dies, so they can still be found;
-- starts the command with ``ROS_LOG_DIR=LOG_DIR`` and ``PR_SET_PDEATHSIG`` = SIGTERM (a killed guard still stops
-  roscore), its output appended to ``LOG_DIR/roscore.log``;
+- starts the command with ``ROS_LOG_DIR=LOG_DIR``, SIGINT and SIGTERM at their default actions (a child inherits
+  ignored signals across ``exec``: a rosmaster that ignored SIGINT could only be SIGKILLed, 15 s later) and
+  ``PR_SET_PDEATHSIG`` = SIGTERM (a killed guard still stops roscore), its output appended to ``LOG_DIR/roscore.log``
+  (:func:`ur3hanoi.lifecycle.child_preexec`);
 - prints ``pid N`` (the roscore's process id) and, if roscore exits by itself, ``exit CODE`` on its stdout;
 - when its standard input reaches end of file -- the station closed it, or the kernel did because the station died,
-  even by SIGKILL -- or on SIGTERM, stops roscore the way it wants to be stopped (SIGINT, twice), then SIGKILLs
-  whatever of its process tree is left, removes ``LOG_DIR`` and exits.
+  even by SIGKILL -- or on SIGINT or SIGTERM, stops roscore the way it wants to be stopped (SIGINT), SIGKILLs
+  whatever of its process tree is left after :data:`STOP_GRACE_S`, removes ``LOG_DIR`` and exits: well within 2 s.
 
 The station's temporary folders are named :data:`LOG_DIR_PREFIX` + the station's pid; :func:`remove_stale_log_dirs`
 removes those of stations that no longer run (a guard killed with SIGKILL cannot clean up).
@@ -20,7 +22,6 @@ removes those of stations that no longer run (a guard killed with SIGKILL cannot
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import os
 import select
 import shutil
@@ -31,16 +32,14 @@ import tempfile
 import time
 from pathlib import Path
 
+from ur3hanoi.lifecycle import PR_SET_CHILD_SUBREAPER, STOP_SIGNALS, child_preexec, prctl
+
 LOG_DIR_PREFIX = "ur3hanoi-roscore-"
 """Temporary folder of one station's roscore logs: ``<tmp>/ur3hanoi-roscore-<station pid>-<random>``."""
 
-_PR_SET_PDEATHSIG = 1
-_PR_SET_CHILD_SUBREAPER = 36
-
-
-def _prctl(option: int, value: int) -> None:
-    libc = ctypes.CDLL(None, use_errno=True)
-    libc.prctl(option, value, 0, 0, 0)
+STOP_GRACE_S = (1.0, 0.5)
+"""How long [s] roscore gets after each of the two SIGINTs (it misses one that arrives while it launches its nodes)
+before what is left of its tree is SIGKILLed: rosmaster stops in about 0.1 s, roscore with rosout in about 0.5 s."""
 
 
 def make_log_dir() -> Path:
@@ -75,13 +74,60 @@ def remove_stale_log_dirs(base: Path | None = None) -> list[Path]:
     return removed
 
 
-def _children() -> list[int]:
+def _parent(pid: int) -> int | None:
+    try:
+        return int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def _guard_station(pid: int) -> int | None:
+    """The station pid of guard process ``pid`` (named in its log folder argument), or None if it is no guard."""
+    try:
+        args = Path(f"/proc/{pid}/cmdline").read_bytes().decode(errors="replace").split("\0")
+    except OSError:
+        return None
+    if __name__ not in args or "--" not in args:  # python -m ur3hanoi.interface.ros1.guard LOG_DIR -- COMMAND...
+        return None
+    folder = Path(args[args.index("--") - 1]).name
+    try:
+        return int(folder.removeprefix(LOG_DIR_PREFIX).split("-")[0]) if folder.startswith(LOG_DIR_PREFIX) else None
+    except ValueError:
+        return None
+
+
+def orphaned(pid: int) -> bool:
+    """True when process ``pid`` (a master) runs under a guard whose station is gone: the guard is stopping it.
+    (A station started again on the same URI at once would otherwise attach to it and lose it a moment later.)"""
+    parent = _parent(pid)
+    for _ in range(3):  # rosmaster under the guard, or under roscore under the guard
+        if parent is None or parent <= 1:
+            return False
+        station = _guard_station(parent)
+        if station is not None:
+            return _parent(parent) != station or not _alive(station)
+        parent = _parent(parent)
+    return False
+
+
+def _children(pid: int | None = None) -> list[int]:
+    """The children of process ``pid`` (default: this one)."""
     pids: list[int] = []
     with contextlib.suppress(OSError):
-        for task in Path(f"/proc/{os.getpid()}/task").iterdir():
+        for task in Path(f"/proc/{os.getpid() if pid is None else pid}/task").iterdir():
             with contextlib.suppress(OSError):
                 pids += [int(p) for p in (task / "children").read_text().split()]
     return pids
+
+
+def _tree(pid: int) -> list[int]:
+    """``pid`` and every process below it."""
+    found, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        found.append(p)
+        todo += [c for c in _children(p) if c not in found]
+    return found
 
 
 def _reap() -> None:
@@ -97,14 +143,16 @@ def _wait(proc: subprocess.Popen[bytes], timeout_s: float) -> bool:
     return False
 
 
-def stop_tree(proc: subprocess.Popen[bytes], sigint_timeout_s: float = 5.0) -> None:
-    """SIGINT ``proc`` (twice: roscore misses one while it launches its nodes), then SIGKILL every process left
-    among this (subreaper) process's children."""
-    for wait_s in (sigint_timeout_s, 2.0 * sigint_timeout_s):
+def stop_tree(proc: subprocess.Popen[bytes], grace_s: tuple[float, ...] = STOP_GRACE_S) -> None:
+    """SIGINT ``proc`` and every process below it, all at once (roscore's nodes then stop together instead of one
+    after the other), once per entry of ``grace_s``, waiting that long [s] after each; then SIGKILL every process
+    left among this (subreaper) process's children."""
+    for wait_s in grace_s:
         if proc.poll() is not None:
             break
-        with contextlib.suppress(ProcessLookupError):
-            proc.send_signal(signal.SIGINT)
+        for pid in _tree(proc.pid):
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGINT)
         if _wait(proc, wait_s):
             break
     deadline = time.monotonic() + 5.0
@@ -112,13 +160,13 @@ def stop_tree(proc: subprocess.Popen[bytes], sigint_timeout_s: float = 5.0) -> N
         for pid in left:
             with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
-        time.sleep(0.05)
+        time.sleep(0.02)
         _reap()
         proc.poll()
 
 
 class _TerminatedError(Exception):
-    """SIGTERM: stop roscore and clean up as on end of file."""
+    """SIGINT or SIGTERM: stop roscore and clean up as on end of file."""
 
 
 def _stop_requested(_signum: int, _frame: object) -> None:
@@ -130,19 +178,17 @@ def main(argv: list[str]) -> int:
         print("usage: python -m ur3hanoi.interface.ros1.guard LOG_DIR -- COMMAND...", file=sys.stderr)
         return 2
     log_dir, command = Path(argv[0]), argv[2:]
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the pipe stops the guard (a Ctrl-C reaches the station first)
-    signal.signal(signal.SIGTERM, _stop_requested)  # so does a SIGTERM (system shutdown): cleanly
-    _prctl(_PR_SET_CHILD_SUBREAPER, 1)
+    # The pipe stops the guard; so do SIGINT and SIGTERM (a system shutdown), cleanly. Handled, not ignored: the
+    # command must not inherit an ignored SIGINT (child_preexec resets both anyway).
+    for s in STOP_SIGNALS:
+        signal.signal(s, _stop_requested)
+    prctl(PR_SET_CHILD_SUBREAPER, 1)
     parent = os.getppid()
-
-    def child_setup() -> None:
-        _prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
-
     env = dict(os.environ, ROS_LOG_DIR=str(log_dir))
     try:
         with open(log_dir / "roscore.log", "ab") as out:
             proc = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT, env=env,
-                                    start_new_session=True, preexec_fn=child_setup)  # single-threaded here
+                                    start_new_session=True, preexec_fn=child_preexec())  # single-threaded here
         print(f"pid {proc.pid}", flush=True)
         reported = False
         with contextlib.suppress(_TerminatedError):
@@ -156,7 +202,8 @@ def main(argv: list[str]) -> int:
                     reported = True
                     with contextlib.suppress(OSError):
                         print(f"exit {proc.returncode}", flush=True)
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        for s in STOP_SIGNALS:
+            signal.signal(s, signal.SIG_IGN)  # stopping now: a second signal must not cut it short
         stop_tree(proc)
     finally:
         shutil.rmtree(log_dir, ignore_errors=True)

@@ -4,7 +4,10 @@
 starts ``roscore -p PORT`` under a guard process (:mod:`ur3hanoi.interface.ros1.guard`) and waits until its ``rosout``
 node is registered too; on exit the guard stops it (SIGINT, the way roscore wants to be stopped; SIGKILL of what is
 left). The guard also does so when the station dies, even by SIGKILL, and the roscore's logs live in a temporary folder
-the guard removes. A master that already answers is used and left running.
+the guard removes. A master that already answers is used and left running, unless it is one a guard is stopping
+because its station died (:func:`ur3hanoi.interface.ros1.guard.orphaned`): then :meth:`RosCore.start` waits until it is
+gone and starts its own (a station restarted after a crash would otherwise attach to a master that vanishes a moment
+later). Whether a master is still there while it is used is :mod:`ur3hanoi.interface.ros1.watch`'s.
 
 Listening: the master started here binds and advertises ``host`` (``ROS_IP``; default ``127.0.0.1``, loopback
 only; any other address binds all interfaces, as rosgraph does). On loopback it is ``rosmaster --core`` alone, the
@@ -45,6 +48,8 @@ LOOPBACK = "127.0.0.1"
 
 PROBE_TIMEOUT_S = 1.0
 """How long [s] a master may take to answer ``getPid`` before the URI counts as not answering."""
+ORPHAN_WAIT_S = 5.0
+"""How long [s] :meth:`RosCore.start` waits for a master whose station died to be stopped by its guard."""
 
 
 def is_loopback(host: str) -> bool:
@@ -168,7 +173,7 @@ class RosCore:
         started: True when this object started the roscore (and will stop it).
     """
 
-    def __init__(self, uri: str, start_timeout: float = 30.0, stop_timeout: float = 15.0,
+    def __init__(self, uri: str, start_timeout: float = 30.0, stop_timeout: float = 5.0,
                  host: str = LOOPBACK) -> None:
         self.master = MasterUri.parse(uri)
         self.uri = uri
@@ -204,24 +209,26 @@ class RosCore:
         return not is_loopback(self.host)
 
     def start(self) -> RosCore:
-        """Start ``roscore`` (``rosmaster`` on loopback) unless a master answers. Raises RosError when it does
-        not answer in time, or something else holds the port."""
-        from ur3hanoi.interface.ros1.guard import make_log_dir, remove_stale_log_dirs
+        """Start ``roscore`` (``rosmaster`` on loopback) unless a master answers (one being stopped because its
+        station died is waited out first). Raises RosError when it does not answer in time, or something else
+        holds the port."""
+        from ur3hanoi.interface.ros1 import guard
 
-        if probe_master(self.uri) is not None:
+        if self._running_master() is not None:
             return self
         if not self.master.is_local:
             raise RosError(f"no ROS master answers at {self.uri} and its host {self.master.host!r} is not this "
                            "machine: start roscore there, or set ROS_MASTER_URI to http://localhost:PORT")
         exe = roscore_executable("roscore" if self.with_rosout else "rosmaster")
         args = [exe, "-p", str(self.master.port)] if self.with_rosout else [exe, "--core", "-p", str(self.master.port)]
-        remove_stale_log_dirs()
-        self._log_dir = make_log_dir()
+        guard.remove_stale_log_dirs()
+        self._log_dir = guard.make_log_dir()
+        self._exit, self._buf = None, b""
         env = listen_env(dict(os.environ, ROS_MASTER_URI=self.uri), self.host)
         # The guard (own session: a Ctrl-C in the terminal reaches the station first, which then stops roscore in
         # order) reads the pipe on its stdin: end of file, when this process closes it or dies, stops roscore.
         self._guard = subprocess.Popen(
-            [sys.executable, "-m", "ur3hanoi.interface.ros1.guard", str(self._log_dir), "--", *args],
+            [sys.executable, "-m", guard.__name__, str(self._log_dir), "--", *args],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env,
             start_new_session=True, bufsize=0)
         self.started = True
@@ -239,6 +246,20 @@ class RosCore:
         self.stop()
         raise RosError(f"roscore -p {self.master.port} did not answer at {self.uri} within {self.start_timeout:g} s "
                        f"(port in use?): {tail}")
+
+    def _running_master(self) -> int | None:
+        """The pid of the master answering at the URI, after waiting out one its guard is stopping (None: none)."""
+        from ur3hanoi.interface.ros1.guard import orphaned
+
+        pid = probe_master(self.uri)
+        deadline = time.monotonic() + ORPHAN_WAIT_S
+        while pid is not None and orphaned(pid):
+            if time.monotonic() > deadline:
+                raise RosError(f"the ROS master at {self.uri} (pid {pid}) belongs to a station that died and is "
+                               f"still being stopped after {ORPHAN_WAIT_S:g} s: try again in a moment")
+            time.sleep(0.05)
+            pid = probe_master(self.uri)
+        return pid
 
     def _read_guard(self) -> None:
         """Take the guard's ``pid N`` / ``exit CODE`` lines that are there (never blocks)."""

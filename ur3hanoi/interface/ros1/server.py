@@ -18,6 +18,12 @@ Real time, the bounded inbox, rate-limited logging and the report are the transp
 ``ROS_MASTER_URI`` (:mod:`ur3hanoi.interface.ros1.master`) and stopped on exit, or when the station dies
 (:mod:`ur3hanoi.interface.ros1.guard`).
 
+The master is watched while the station runs (:class:`~ur3hanoi.interface.ros1.watch.MasterWatch`): when it is gone
+(killed, crashed, stopped by someone else) the station says so on stderr within about a second and, if it had started
+that master, starts it again on the same URI and registers with it again (nodes connected before keep their
+connections; nodes started now find the station); a master it did not start, or one it cannot start again, stops
+the station: report written, one error line, exit 2. The report's ``master_events`` records what happened.
+
 A flood cannot stall the loop: the ROS callbacks only append to the bounded inbox
 (:data:`~ur3hanoi.interface.server.INBOX_MAX` messages), log lines are rate-limited and the records bounded
 (:class:`~ur3hanoi.interface.server.StationCore`).
@@ -45,6 +51,7 @@ from __future__ import annotations
 import ipaddress
 import os
 import sys
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -105,6 +112,9 @@ class RosStation(StationCore):
                            "listening on loopback only: give --host ADDR, this machine's address on the lab network")
         self.roscore_started = False
         self._rospy: Any = None
+        self._core: Any = None  # the RosCore while running
+        self.master_events: list[dict[str, Any]] = []
+        self._master_failed: str | None = None
 
     # ---------------------------------------------------------------------------------------------- callbacks
     def _on_spawn(self, msg: Any) -> None:
@@ -122,14 +132,52 @@ class RosStation(StationCore):
 
     # ------------------------------------------------------------------------------------------------ report
     def _report_transport(self) -> dict[str, Any]:
-        return {"master_uri": self.master_uri, "roscore_started": self.roscore_started}
+        return {"master_uri": self.master_uri, "roscore_started": self.roscore_started,
+                "master_events": list(self.master_events)}
+
+    # ------------------------------------------------------------------------------------------------ master
+    def _master_event(self, event: str, **fields: Any) -> None:
+        wall = time.perf_counter() - self._wall0 if self._wall0 else 0.0
+        self.master_events.append({"wall_time_s": round(wall, 3), "event": event, **fields})
+
+    def _master_lost(self, reason: str) -> int | None:
+        """The watch thread's ``on_lost``: start the station's own master again and register with it (its pid),
+        or stop the station (None)."""
+        from ur3hanoi.interface.ros1.master import master_pid
+        from ur3hanoi.interface.ros1.watch import forget_master, reregister
+
+        core, uri = self._core, self.master_uri
+        self._master_event("lost", reason=reason)
+        if core is None or not core.started:
+            forget_master()
+            self._master_failed = (f"the ROS master at {uri} is gone ({reason}); the station did not start it, so it "
+                                   "stops: start the master again, then the station")
+            return None
+        self.out(f"ur3hanoi ros-station: the ROS master at {uri} is gone ({reason}): starting it again")
+        try:
+            core.stop()
+            core.start()
+            pid = master_pid(uri)
+            if pid is None:
+                raise RosError("it does not answer")
+        except RosError as exc:
+            forget_master()
+            self._master_failed = f"the ROS master at {uri} is gone ({reason}) and could not be started again: {exc}"
+            return None
+        registered = reregister()
+        self.roscore_started = core.started
+        self._master_event("restarted" if core.started else "attached", pid=pid, registered=registered)
+        self.out(f"ur3hanoi ros-station: {'started the ROS master again' if core.started else 'found a ROS master'} "
+                 f"at {uri} (pid {pid}) and registered {registered} topics with it")
+        return pid
 
     # --------------------------------------------------------------------------------------------------- run
     def run(self) -> dict[str, Any]:
         """Start (or use) the master, run the node until SIGINT/SIGTERM or ``duration_s``; returns the report."""
         from ur3hanoi.interface.ros1.env import import_rospy, import_std_msgs
-        from ur3hanoi.interface.ros1.master import RosCore, listen_env
+        from ur3hanoi.interface.ros1.master import RosCore, listen_env, master_pid
         from ur3hanoi.interface.ros1.msgs import load_messages
+        from ur3hanoi.interface.ros1.watch import MasterWatch, quick_shutdown
 
         msgs = load_messages()
         rospy = self._rospy = import_rospy()
@@ -141,25 +189,30 @@ class RosStation(StationCore):
         try:
             # The rendering process starts before rospy's threads.
             with self.signals(), self.rendering(), RosCore(self.master_uri, host=self.options.host) as core:
-                self.roscore_started = core.started
+                self._core, self.roscore_started = core, core.started
                 # rospy reads these from the environment: the master, and the address to bind and advertise.
                 env = listen_env(dict(os.environ, ROS_MASTER_URI=self.master_uri), self.options.host)
                 os.environ.pop("ROS_HOSTNAME", None)
                 os.environ.update(env)
                 rospy.init_node(NODE_NAME, argv=[sys.argv[0]], disable_signals=True)
+                quick_shutdown()
                 pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
                 pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
                 rospy.Subscriber("/ur3/command", msgs.command, self.on_command, queue_size=100)
                 rospy.Subscriber("/ur3hanoi/spawn", std_msgs.Int32, self._on_spawn, queue_size=10)
                 rospy.Subscriber("/ur3hanoi/remove_block", std_msgs.Int32, self._on_remove, queue_size=10)
                 try:
-                    self._run_loop(msgs, pub_pos, pub_grip)
+                    with MasterWatch(self.master_uri, master_pid(self.master_uri) or 0, self._master_lost):
+                        self._run_loop(msgs, pub_pos, pub_grip)
                 finally:
                     rospy.signal_shutdown("ur3hanoi ros-station stopped")
                 self.close_sink()  # the report has the final frame counts
                 report = self.write_report()
         finally:
             sys.setswitchinterval(switch)
+            self._core = None
+        if self._master_failed is not None:
+            raise RosError(self._master_failed)
         return report
 
     def _run_loop(self, msgs: Any, pub_pos: Any, pub_grip: Any) -> None:
@@ -175,4 +228,5 @@ class RosStation(StationCore):
         ready = (f"{READY_LINE} on {self.master_uri}: {st.name}, {spawned} blocks on tower {opts.start + 1}, "
                  f"{1.0 / w.config.period_s:g} Hz, suction profile {w.cup.profile.name} (pid {os.getpid()})")
         # The ROS callbacks fill the inbox in rospy's threads: nothing to receive here.
-        self.loop(ready, lambda: None, publish, running=lambda: not self._rospy.is_shutdown())
+        self.loop(ready, lambda: None, publish,
+                  running=lambda: self._master_failed is None and not self._rospy.is_shutdown())

@@ -19,6 +19,12 @@
   and keep a ghost of it after a crash (no participant with gid zero ever leaves): measured, not done.
 - Fast DDS 3 (Kilted) announces XTypes information that Cyclone rejects for sequence types unless told to ignore
   eProsima's (vendor 1.15): the config does.
+- **Lease**: the participant's lease is :data:`LEASE_DURATION_S` (Cyclone's default is 10 s): a station killed by
+  SIGKILL (or a crash) cannot say goodbye, and its peers keep a ghost of it -- a second ``ur3hanoi_station`` in the
+  graph, a matched reader that never reads -- until the lease ends. A station restarted at once is thus alone in
+  the graph within 3 s. A live participant never comes near it: the station writes every 8 ms, any message renews
+  the lease, and Cyclone announces the participant every 0.8 lease (2.4 s) when it is silent; only a process
+  frozen for 3 s is dropped, and found again by its next announcement.
 """
 
 from __future__ import annotations
@@ -39,6 +45,9 @@ from ur3hanoi.interface.ros2.msgs import (
 LOOPBACK = "loopback"
 LAB = "lab"
 
+LEASE_DURATION_S = 3
+"""The participant's DDS lease [s]: how long peers keep it after it falls silent (killed, crashed, frozen)."""
+
 _COMPATIBILITY = "<Compatibility><IgnoreTypeInformation>1.15</IgnoreTypeInformation></Compatibility>"
 
 
@@ -48,9 +57,8 @@ def cyclone_config(network: str = LOOPBACK) -> str:
     if network == LOOPBACK:
         general = ('<General><Interfaces><NetworkInterface name="lo"/></Interfaces>'
                    "<AllowMulticast>false</AllowMulticast></General>")
-        discovery = ("<Discovery><ParticipantIndex>auto</ParticipantIndex>"
-                     "<MaxAutoParticipantIndex>30</MaxAutoParticipantIndex>"
-                     '<Peers><Peer address="127.0.0.1"/></Peers></Discovery>')
+        discovery = ("<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>30</MaxAutoParticipantIndex>"
+                     '<Peers><Peer address="127.0.0.1"/></Peers>')
     elif network == LAB:
         general, discovery = "", ""
     else:
@@ -58,7 +66,9 @@ def cyclone_config(network: str = LOOPBACK) -> str:
             raise ValueError(f"network interface {network!r} is invalid: expected loopback, lab or an interface name")
         general = f'<General><Interfaces><NetworkInterface name="{network}"/></Interfaces></General>'
         discovery = ""
-    return f'<CycloneDDS><Domain id="any">{general}{_COMPATIBILITY}{discovery}</Domain></CycloneDDS>'
+    lease = f"<LeaseDuration>{LEASE_DURATION_S} s</LeaseDuration>"
+    return (f'<CycloneDDS><Domain id="any">{general}{_COMPATIBILITY}<Discovery>{lease}{discovery}</Discovery>'
+            "</Domain></CycloneDDS>")
 
 
 def domain_id_from_env() -> int:
