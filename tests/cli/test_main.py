@@ -14,7 +14,7 @@ import yaml
 
 from tests.conftest import LAB_REAL, LAB_SIM, REPO
 from tests.support.ros_support import free_port, requires_ros, ros_env, run, ur3hanoi_cmd
-from ur3hanoi.cli import main
+from ur3hanoi.cli import main, progress
 from ur3hanoi.cli.exit_codes import EXIT_CODES, exit_code_for
 from ur3hanoi.cli.options import DWELL, RATE, SEED, SPEED, option
 from ur3hanoi.errors import PlanError, SuctionFaultError, Ur3HanoiError
@@ -579,17 +579,16 @@ def test_ros_station_report_dash_is_standard_output(tmp_path: Path) -> None:
 def test_ctrl_c_during_a_rendered_solve_leaves_the_old_output(option: str, tmp_path: Path,
                                                               monkeypatch: pytest.MonkeyPatch,
                                                               capsys: pytest.CaptureFixture[str]) -> None:
-    from ur3hanoi.cli import solve
 
-    real = solve._ProgressLines.__call__
+    real = progress.ProgressLines.__call__
 
-    def interrupt_halfway(self: solve._ProgressLines, fraction: float, label: str) -> None:
+    def interrupt_halfway(self: progress.ProgressLines, fraction: float, label: str) -> None:
         real(self, fraction, label)
         # Frames rendered (during the run, or by the parallel workers after it): then Ctrl-C.
         if fraction >= 0.5 and (getattr(self.recorder, "count", 0) > 0 or "frame" in label):
             raise KeyboardInterrupt
 
-    monkeypatch.setattr(solve._ProgressLines, "__call__", interrupt_halfway)
+    monkeypatch.setattr(progress.ProgressLines, "__call__", interrupt_halfway)
     out = tmp_path / ("run.mp4" if option == "--video" else "frames")
     if option == "--video":
         out.write_bytes(b"the previous video")

@@ -6,7 +6,6 @@ import pytest
 
 from tests.support.ros_support import free_port
 from ur3hanoi.cli import main
-from ur3hanoi.cli.solve import prompt_tower
 
 
 def error_line(capsys) -> str:
@@ -53,15 +52,6 @@ def test_ros_solve_without_a_master_exits_2(capsys):
     uri = f"http://127.0.0.1:{free_port()}"
     assert main(["ros-solve", "--start", "1", "--end", "3", "--master", uri]) == 2
     assert f"ur3hanoi: error: no ROS master answers at {uri}: start `ur3hanoi ros-station`" in error_line(capsys)
-
-
-def test_prompt_repeats_like_the_lab_program(monkeypatch, capsys):
-    answers = iter(["4", "x", "1", "3"])
-    monkeypatch.setattr("builtins.input", lambda prompt: print(prompt, end="") or next(answers))
-    assert prompt_tower("end", 3, exclude=0) == 2
-    out = capsys.readouterr().out
-    assert out.count("Enter the end tower <2 or 3> ") == 4
-    assert out.count("Please just enter the character 2 or 3") == 3
 
 
 @pytest.mark.parametrize(("command", "station"), [("ros-solve", "lab_sim"), ("ros2-solve", "ur3e_sim")])

@@ -19,12 +19,12 @@ from typing import TYPE_CHECKING, Any
 from ur3hanoi.cli.main import build_parser, help_markdown, main
 
 if TYPE_CHECKING:
-    from ur3hanoi.cli.solve import prompt_tower
+    from ur3hanoi.cli.prompt import prompt_tower
 
 
 def __getattr__(name: str) -> Any:
     if name == "prompt_tower":  # imported on use: a run imports only its own command's module
-        from ur3hanoi.cli.solve import prompt_tower
+        from ur3hanoi.cli.prompt import prompt_tower
 
         return prompt_tower
     raise AttributeError(f"module 'ur3hanoi.cli' has no attribute {name!r}")

@@ -27,11 +27,10 @@ from ur3hanoi.cli.options import (
     ROS_RATE,
     SEED,
     UsageError,
-    check_number,
     option,
     station_number,
 )
-from ur3hanoi.cli.solve import prompt_tower
+from ur3hanoi.cli.prompt import towers
 
 if TYPE_CHECKING:
     from ur3hanoi.arrays import FloatArray
@@ -183,16 +182,7 @@ def solve_job(args: argparse.Namespace, command: str, default_calibration: str, 
     n_towers, n_heights = Q.shape[0], Q.shape[1]
     n_blocks = n_heights if args.blocks is None else args.blocks
     why = f"{station.name} has {n_towers} towers" if station is not None else f"the table has {n_towers} towers"
-    check_number("--start", args.start, n_towers, "a tower", why)
-    check_number("--end", args.end, n_towers, "a tower", why)
-    if args.start is None or args.end is None:
-        if not sys.stdin.isatty():
-            raise UsageError("--start and --end are required when stdin is not a terminal "
-                             f"(towers 1..{n_towers}), e.g. ur3hanoi {command} --start 1 --end 3")
-        start = args.start - 1 if args.start is not None else prompt_tower("start", n_towers)
-        end = args.end - 1 if args.end is not None else prompt_tower("end", n_towers, exclude=start)
-    else:
-        start, end = args.start - 1, args.end - 1
+    start, end = towers(args, n_towers, why, command)
     validate_instance(n_blocks, start, end, n_towers, n_heights)
     if recorded is not None:
         Q = recorded.for_solve(start, end, n_blocks)

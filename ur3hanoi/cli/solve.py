@@ -17,7 +17,7 @@ import math
 import os
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from ur3hanoi.cli import exit_codes
 from ur3hanoi.cli.common import (
@@ -39,29 +39,24 @@ from ur3hanoi.cli.options import (
     UsageError,
     check_blocks,
     check_faults,
-    check_number,
     check_plan_size,
     check_window,
     image_size,
     option,
     station_number,
 )
+from ur3hanoi.cli.progress import phases, progress_sink
+from ur3hanoi.cli.prompt import towers
 from ur3hanoi.errors import SuctionFaultError, Ur3HanoiError
 
 if TYPE_CHECKING:
-    from ur3hanoi.sim import ProgressFn
+    from ur3hanoi.plan import Plan
+    from ur3hanoi.sim import ProgressFn, SimResult, TaskScene
+    from ur3hanoi.station.calibration import Station
 
 VIDEO_EXTENSIONS = (".mp4", ".mkv", ".mov", ".webm", ".gif")
 """The video extensions, for the help text (kept equal to ``ur3hanoi.sim.VIDEO_FORMATS``, which is not imported
 here: building the parser must not load MuJoCo)."""
-
-PROGRESS_STEP = 0.1
-"""Fraction of the run between two plain progress lines (when stderr is not a terminal)."""
-
-SIM_SHARE = 0.05
-"""Share of the progress bar given to simulating when the frames render afterwards in worker processes (the
-simulation takes about 1.5 s of a 30 s video job); the rest counts the frames rendered."""
-
 
 def add(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("solve", help="run the lab in MuJoCo: plan, execute with suction feedback, verify",
@@ -118,22 +113,6 @@ def add(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def prompt_tower(what: str, n_towers: int, exclude: int | None = None) -> int:
-    """Prompt like the lab program until a valid tower (1-based) is entered; returns it 0-based."""
-    choices = " ".join(str(t) for t in range(1, n_towers + 1) if t - 1 != exclude)
-    options = choices.rsplit(" ", 1)
-    label = f"{options[0]} or {options[1]}" if len(options) == 2 else choices
-    while True:
-        try:
-            text = input(f"Enter the {what} tower <{label}> ")
-        except EOFError:
-            raise UsageError(f"no {what} tower entered (end of input)") from None
-        text = text.strip()
-        if text.isdigit() and len(text) < 4 and 1 <= int(text) <= n_towers and int(text) - 1 != exclude:
-            return int(text) - 1
-        print(f"Please just enter the character {label}\n")
-
-
 def render_workers() -> int:
     """Processes rendering video frames: one per core the process may use (software GL renders one frame per
     core at a time), at most 8."""
@@ -142,58 +121,6 @@ def render_workers() -> int:
     except (AttributeError, OSError):
         cores = os.cpu_count() or 1
     return max(1, min(8, cores))
-
-
-def _progress(fraction: float, label: str) -> None:
-    width = 30
-    filled = round(width * fraction)
-    end = "\n" if fraction >= 1.0 else ""
-    print(f"\r[{'#' * filled}{'.' * (width - filled)}] {100 * fraction:5.1f}% {label:<12}", end=end,
-          file=sys.stderr, flush=True)
-
-
-class _ProgressLines:
-    """Progress as plain stderr lines every :data:`PROGRESS_STEP` of the run (for logs and pipes), with the
-    number of frames written so far when rendering."""
-
-    def __init__(self, recorder: object | None) -> None:
-        self.recorder = recorder
-        self.reported = -1
-
-    def __call__(self, fraction: float, label: str) -> None:
-        step = math.floor(fraction / PROGRESS_STEP + 1e-9)
-        if step <= self.reported:
-            return
-        self.reported = step
-        frames = getattr(self.recorder, "count", None)
-        extra = f", {frames} frames" if frames is not None else ""
-        print(f"ur3hanoi solve: {100 * fraction:3.0f} % ({label}{extra})", file=sys.stderr, flush=True)
-
-
-def _phases(progress: ProgressFn | None) -> tuple[ProgressFn | None, ProgressFn | None]:
-    """One progress bar over two phases: the simulation (:data:`SIM_SHARE`), then the frames rendered."""
-    if progress is None:
-        return None, None
-
-    def simulating(fraction: float, label: str) -> None:
-        progress(SIM_SHARE * fraction, "simulated" if fraction >= 1.0 else label)
-
-    def rendering(fraction: float, label: str) -> None:
-        progress(SIM_SHARE + (1.0 - SIM_SHARE) * fraction, label)
-
-    return simulating, rendering
-
-
-def _progress_sink(args: argparse.Namespace, recorder: object | None) -> ProgressFn | None:
-    """A bar on a terminal; plain lines when rendering or with --progress; nothing otherwise (and never with
-    --view, whose window shows the run)."""
-    if args.view:
-        return None
-    if sys.stderr.isatty():
-        return _progress
-    if args.progress or args.video or args.frames:
-        return _ProgressLines(recorder)
-    return None
 
 
 def _check_render_options(args: argparse.Namespace) -> None:
@@ -222,21 +149,6 @@ def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
     check_render_outputs(args.video, args.frames, inputs)
 
 
-def _towers(args: argparse.Namespace, n_towers: int, station_name: str = "") -> tuple[int, int]:
-    """Start and end tower, 0-based: from the options, or prompted for on a terminal."""
-    why = f"{station_name} has {n_towers} towers" if station_name else ""
-    check_number("--start", args.start, n_towers, "a tower", why)
-    check_number("--end", args.end, n_towers, "a tower", why)
-    if args.start is not None and args.end is not None:
-        return args.start - 1, args.end - 1
-    if not sys.stdin.isatty():
-        raise UsageError("--start and --end are required when stdin is not a terminal "
-                         f"(towers 1..{n_towers}), e.g. ur3hanoi solve --start 1 --end 3")
-    start = args.start - 1 if args.start is not None else prompt_tower("start", n_towers)
-    end = args.end - 1 if args.end is not None else prompt_tower("end", n_towers, exclude=start)
-    return start, end
-
-
 def _table_calibration(args: argparse.Namespace) -> str:
     """The calibration to simulate on: given, the default one, or (for a real station's table) required."""
     if args.table is None:
@@ -251,11 +163,21 @@ def _table_calibration(args: argparse.Namespace) -> str:
     return calibration_ref(args.calibration)
 
 
-def run(args: argparse.Namespace) -> int:
-    import json
+class _Job(NamedTuple):
+    """What a ``solve`` run does, its options checked: the station, the instance and the table to follow."""
 
+    station: Station
+    start: int
+    end: int
+    n_blocks: int
+    table: Any  # the visited entries of a recorded table (FloatArray), or None: generated waypoints
+    inputs: list[Path]
+
+
+def _job(args: argparse.Namespace) -> _Job:
+    """Every option checked (and the towers asked for on a terminal) before anything is simulated."""
     from ur3hanoi.hanoi import validate_instance
-    from ur3hanoi.plan import PlanConfig, plan_solve, plan_table
+    from ur3hanoi.plan import PlanConfig
     from ur3hanoi.station.calibration import load_station
 
     _check_render_options(args)
@@ -266,7 +188,7 @@ def run(args: argparse.Namespace) -> int:
         from ur3hanoi.station.calibration import with_suction_profile
 
         station = with_suction_profile(station, args.suction_profile)
-    table = recorded = None
+    recorded = None
     if args.table is not None:
         from ur3hanoi.plan import check_table_shape
         from ur3hanoi.tables import read_recorded_table
@@ -279,10 +201,9 @@ def run(args: argparse.Namespace) -> int:
     n_towers = station.n_towers
     n_blocks = station.n_heights if args.blocks is None else args.blocks
     check_blocks(n_blocks, station.n_heights, given=args.blocks is not None)
-    start, end = _towers(args, n_towers, station.name)
+    start, end = towers(args, n_towers, f"{station.name} has {n_towers} towers" if station.name else "", "solve")
     validate_instance(n_blocks, start, end, n_towers, station.n_heights)
-    if recorded is not None:
-        table = recorded.for_solve(start, end, n_blocks)
+    table = recorded.for_solve(start, end, n_blocks) if recorded is not None else None
     check_faults(args.remove_block, args.drop_during_move, n_blocks)
     plan_config = PlanConfig(speed=args.speed)
     check_plan_size(n_blocks, args.speed, plan_config.dwell_s, plan_config.rate_hz)
@@ -290,64 +211,47 @@ def run(args: argparse.Namespace) -> int:
         # Headless offscreen rendering: read when MuJoCo is first imported (the output check below imports it).
         os.environ["MUJOCO_GL"] = "egl"
     _check_render_outputs(args, inputs)
+    return _Job(station, start, end, n_blocks, table, inputs)
 
-    from ur3hanoi.sim import (
-        CameraConfig,
-        Faults,
-        OffscreenRecorder,
-        SimConfig,
-        SimResult,
-        ViewerSink,
-        build_task_scene,
-        display_available,
-        run_plan,
-    )
 
-    if args.view and display_available() is not None:
-        raise UsageError(f"--view cannot open the MuJoCo viewer: {display_available()}; "
-                         "use --video FILE.mp4 or --frames DIR")
-    faults = Faults(
-        remove_block=None if args.remove_block is None else args.remove_block - 1,
-        drop_during_move=None if args.drop_during_move is None else args.drop_during_move - 1,
-    )
-    config = SimConfig(seed=args.seed)
-    if table is not None:
-        plan = plan_table(station, table, start, end, n_blocks, plan_config, where=f"{args.table}:{args.key}")
-    else:
-        plan = plan_solve(station, start, end, n_blocks, plan_config)
-    if args.t_from is not None and args.t_from >= plan.duration_s:
-        raise UsageError(f"--from {args.t_from:g} is invalid: the planned motion lasts {plan.duration_s:.2f} s of "
-                         "sim time: expected an earlier time")
-    scene = build_task_scene(station, start, n_blocks, faults.remove_block, config.scene)
-    sink: object | None = None
+def _sink(args: argparse.Namespace, station: Station, scene: TaskScene) -> tuple[object | None, ProgressFn | None]:
+    """(frame sink: the viewer, the offscreen recorder or none; the simulation's progress)."""
+    from ur3hanoi.sim import CameraConfig, OffscreenRecorder, ViewerSink
+
+    if args.view:
+        return ViewerSink(scene.model, scene.data), None
+    if not (args.video or args.frames):
+        return None, progress_sink(args, None)
+    workers = render_workers()
+    sim_progress, render_progress = (phases(progress_sink(args, None)) if workers > 1  # frames render afterwards
+                                     else (None, None))
+    default = CameraConfig()
+    width, height = args.size if args.size is not None else (default.width, default.height)
+    camera = CameraConfig(width=width, height=height, fps=args.fps if args.fps is not None else default.fps)
+    sink = OffscreenRecorder(station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
+                             video=Path(args.video) if args.video else None, camera=camera,
+                             t_from=args.t_from or 0.0, t_to=args.t_to, workers=workers, progress=render_progress)
+    return sink, sim_progress if sim_progress is not None else progress_sink(args, sink)
+
+
+def _simulate(args: argparse.Namespace, job: _Job, plan: Plan, scene: TaskScene, faults: Any, config: Any
+              ) -> tuple[SimResult, Ur3HanoiError | None, Any, Any]:
+    """Run ``plan`` in ``scene`` with the sinks the options ask for: (result, the suction fault that halted it or
+    None, the frame sink, the replay recorder). An interrupted or failed run leaves an existing video as it was."""
+    from ur3hanoi.sim import OffscreenRecorder, SimResult, run_plan
+
+    sink, sim_progress = _sink(args, job.station, scene)
+    frames, replay = sink, None
     fault: Ur3HanoiError | None = None
-    sim_progress: ProgressFn | None = None
-    render_progress: ProgressFn | None = None
     try:
-        if args.view:
-            sink = ViewerSink(scene.model, scene.data)
-        elif args.video or args.frames:
-            workers = render_workers()
-            if workers > 1:  # frames render after the run, in worker processes: one bar over both phases
-                sim_progress, render_progress = _phases(_progress_sink(args, None))
-            default = CameraConfig()
-            width, height = args.size if args.size is not None else (default.width, default.height)
-            camera = CameraConfig(width=width, height=height, fps=args.fps if args.fps is not None else default.fps)
-            sink = OffscreenRecorder(station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
-                                     video=Path(args.video) if args.video else None, camera=camera,
-                                     t_from=args.t_from or 0.0, t_to=args.t_to, workers=workers,
-                                     progress=render_progress)
-        if sim_progress is None:
-            sim_progress = _progress_sink(args, sink if args.video or args.frames else None)
-        frames = sink
         if args.html:
             from ur3hanoi.replay import REPLAY_FPS, PoseRecorder, SinkTee
 
             replay = PoseRecorder(scene.model, REPLAY_FPS)
             frames = replay if sink is None else SinkTee([sink, replay])  # type: ignore[list-item]
         try:
-            result = run_plan(plan, faults, config, frames=frames, progress=sim_progress,  # type: ignore[arg-type]
-                              scene=scene, realtime=args.view)
+            result = run_plan(plan, faults, config, frames=frames,  # type: ignore[arg-type]
+                              progress=sim_progress, scene=scene, realtime=args.view)
         except SuctionFaultError as exc:
             # A halted run still has a result to report (the final block positions, the halt).
             if not isinstance(exc.result, SimResult):
@@ -357,12 +261,38 @@ def run(args: argparse.Namespace) -> int:
             sink.render_pending()  # the frames, in parallel processes (progress per frame)
     except BaseException:
         if isinstance(sink, OffscreenRecorder):
-            sink.discard()  # an interrupted or failed run leaves an existing video or folder as it was
+            sink.discard()
         raise
     finally:
         if sink is not None:
             sink.close()  # type: ignore[attr-defined]
+    return result, fault, sink, replay
 
+
+def run(args: argparse.Namespace) -> int:
+    from ur3hanoi.plan import PlanConfig, plan_solve, plan_table
+    from ur3hanoi.sim import Faults, SimConfig, build_task_scene, display_available
+
+    job = _job(args)
+    station, start, end, n_blocks = job.station, job.start, job.end, job.n_blocks
+    if args.view and display_available() is not None:
+        raise UsageError(f"--view cannot open the MuJoCo viewer: {display_available()}; "
+                         "use --video FILE.mp4 or --frames DIR")
+    faults = Faults(
+        remove_block=None if args.remove_block is None else args.remove_block - 1,
+        drop_during_move=None if args.drop_during_move is None else args.drop_during_move - 1,
+    )
+    plan_config = PlanConfig(speed=args.speed)
+    if job.table is not None:
+        plan = plan_table(station, job.table, start, end, n_blocks, plan_config, where=f"{args.table}:{args.key}")
+    else:
+        plan = plan_solve(station, start, end, n_blocks, plan_config)
+    if args.t_from is not None and args.t_from >= plan.duration_s:
+        raise UsageError(f"--from {args.t_from:g} is invalid: the planned motion lasts {plan.duration_s:.2f} s of "
+                         "sim time: expected an earlier time")
+    config = SimConfig(seed=args.seed)
+    scene = build_task_scene(station, start, n_blocks, faults.remove_block, config.scene)
+    result, fault, sink, replay = _simulate(args, job, plan, scene, faults, config)
     html_size = None
     if args.html:
         from ur3hanoi.replay import write_run_replay
@@ -370,34 +300,43 @@ def run(args: argparse.Namespace) -> int:
         following = f", following {args.table}:{args.key}" if args.table is not None else ""
         title = (f"{station.name}: {n_blocks} blocks, tower {start + 1} -> {end + 1}{following}: {result.status} "
                  f"({result.moves_completed}/{result.moves_total} moves)")
-        html_size = write_run_replay(args.html, plan, scene, replay, result, title, tuple(inputs))
-    if args.json:
-        out = result.as_dict()
-        out["suction"] = station.suction.as_dict()
-        if args.table is not None:
-            out["table"] = {"file": str(args.table), "key": args.key}
-        print(json.dumps(out))
-    else:
-        following = f", following {shown(args.table)}:{args.key}" if args.table is not None else ""
-        print(f"{result.status}: {result.moves_completed}/{result.moves_total} moves, tower {start + 1} -> "
-              f"{end + 1}, {len(result.final_blocks)} blocks on {shown(station.name)}{following} (suction profile "
-              f"{station.suction.name})")
-        for b in result.final_blocks:
-            where = "in no slot"
-            if b.tower is not None and b.height is not None:
-                where = f"tower {b.tower + 1} height {b.height + 1}"
-            print(f"  block {b.block + 1} ({b.as_dict()['colour']}): {where} at "
-                  f"[{b.xyz[0]:.4f}, {b.xyz[1]:.4f}, {b.xyz[2]:.4f}] m")
-        print(f"  sim {result.sim_time_s:.2f} s in {result.wall_time_s:.2f} s wall ({result.realtime_factor:.1f}x "
-              f"real time), max tracking error {math.degrees(result.max_tracking_error_rad):.3f} deg, suction "
-              f"{'on' if result.suction_on_at_end else 'off'}, {'at' if result.at_home_at_end else 'not at'} home")
-        if args.video or args.frames:
-            print(f"  wrote {sink.count} frames to {shown(args.video or args.frames)}")  # type: ignore[union-attr]
-        if html_size is not None:
-            print(f"  wrote the replay page {shown(args.html)} ({html_size / 1e6:.1f} MB)")
+        html_size = write_run_replay(args.html, plan, scene, replay, result, title, tuple(job.inputs))
+    _print_outcome(args, job, result, sink, html_size)
     if fault is not None:
         print(f"ur3hanoi: error: {' '.join(str(fault).split())}", file=sys.stderr)
         return exit_codes.exit_code_for(fault)
     if result.error is not None:
         print(f"ur3hanoi: error: {' '.join(str(result.error).split())}", file=sys.stderr)
     return int(result.exit_code)
+
+
+def _print_outcome(args: argparse.Namespace, job: _Job, result: SimResult, sink: Any,
+                   html_size: int | None) -> None:
+    """The outcome on stdout: one JSON object with ``--json``, else a summary with every block's place."""
+    station = job.station
+    if args.json:
+        import json
+
+        out = result.as_dict()
+        out["suction"] = station.suction.as_dict()
+        if args.table is not None:
+            out["table"] = {"file": str(args.table), "key": args.key}
+        print(json.dumps(out))
+        return
+    following = f", following {shown(args.table)}:{args.key}" if args.table is not None else ""
+    print(f"{result.status}: {result.moves_completed}/{result.moves_total} moves, tower {job.start + 1} -> "
+          f"{job.end + 1}, {len(result.final_blocks)} blocks on {shown(station.name)}{following} (suction profile "
+          f"{station.suction.name})")
+    for b in result.final_blocks:
+        where = "in no slot"
+        if b.tower is not None and b.height is not None:
+            where = f"tower {b.tower + 1} height {b.height + 1}"
+        print(f"  block {b.block + 1} ({b.as_dict()['colour']}): {where} at "
+              f"[{b.xyz[0]:.4f}, {b.xyz[1]:.4f}, {b.xyz[2]:.4f}] m")
+    print(f"  sim {result.sim_time_s:.2f} s in {result.wall_time_s:.2f} s wall ({result.realtime_factor:.1f}x "
+          f"real time), max tracking error {math.degrees(result.max_tracking_error_rad):.3f} deg, suction "
+          f"{'on' if result.suction_on_at_end else 'off'}, {'at' if result.at_home_at_end else 'not at'} home")
+    if args.video or args.frames:
+        print(f"  wrote {sink.count} frames to {shown(args.video or args.frames)}")
+    if html_size is not None:
+        print(f"  wrote the replay page {shown(args.html)} ({html_size / 1e6:.1f} MB)")
