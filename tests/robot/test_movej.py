@@ -20,7 +20,7 @@ rates = st.floats(0.05, 10.0)
 
 def sampled(mv, n: int = 400) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     t = np.linspace(0.0, mv.duration, n)
-    qs, vs = zip(*(mv.sample(x) for x in t), strict=True)
+    qs, vs, _accs = zip(*(mv.sample(x) for x in t), strict=True)
     return t, np.array(qs), np.array(vs)
 
 
@@ -58,6 +58,24 @@ def test_acceleration_of_samples_within_caps():
     acc = np.abs(np.diff(vs, axis=0)) / np.diff(t)[:, None]
     assert np.all(acc <= np.minimum(4.0, A_MAX) + 1e-6)
     assert np.all(np.abs(vs) <= np.minimum(4.0, V_MAX) + 1e-9)
+
+
+@settings(max_examples=50, deadline=None)
+@given(angles, angles, rates, rates)
+def test_sampled_acceleration_is_the_rate_of_the_sampled_velocity(q0, q1, v, a):
+    """The reference acceleration the servo's feed-forward uses: over any interval, its mean (the trapezoid is
+    piecewise constant in acceleration: integrated exactly on a fine grid) is the change of velocity."""
+    mv = plan_movej(q0, q1, v, a, V_MAX, A_MAX)
+    if not 0.0 < mv.duration < 100.0:
+        return
+    t = np.linspace(-0.01, mv.duration + 0.01, 4001)
+    _qs, vs, accs = (np.array(x) for x in zip(*(mv.sample(x) for x in t), strict=True))
+    integral = np.cumsum(0.5 * (accs[1:] + accs[:-1]) * np.diff(t)[:, None], axis=0)
+    # Each of the (at most 4) acceleration steps costs at most one grid interval times the step's height.
+    tol = 4 * np.diff(t)[0] * mv.peak_acceleration + 1e-9
+    assert np.all(np.abs(vs[1:] - vs[0] - integral) <= tol)
+    assert np.all(np.abs(accs) <= mv.peak_acceleration * (1 + 1e-9) + 1e-12)
+    np.testing.assert_array_equal(mv.sample(mv.duration)[2], np.zeros(6))
 
 
 def test_long_move_lasts_distance_over_speed_plus_ramp():

@@ -61,27 +61,29 @@ class MoveJ:
         """Acceleration of each joint during the ramps [rad/s^2] (absolute value)."""
         return np.abs(self.q1 - self.q0) * self.s_acc
 
-    def path(self, t: float) -> tuple[float, float]:
-        """The path parameter ``s`` and its rate ``ds/dt`` [1/s] at time ``t`` [s] (clamped to [0, duration])."""
+    def path(self, t: float) -> tuple[float, float, float]:
+        """The path parameter ``s``, its rate ``ds/dt`` [1/s] and its acceleration ``d2s/dt2`` [1/s^2] at time
+        ``t`` [s] (clamped to [0, duration]; the acceleration steps at the ramps' ends, and is zero at rest)."""
         T, ta, A, V = self.duration, self.t_acc, self.s_acc, self.s_vel
         if t <= 0.0 or T <= 0.0:
-            return (1.0, 0.0) if T <= 0.0 else (0.0, 0.0)
+            return (1.0, 0.0, 0.0) if T <= 0.0 else (0.0, 0.0, 0.0)
         if t >= T:
-            return 1.0, 0.0
+            return 1.0, 0.0, 0.0
         if t < ta:
-            return 0.5 * A * t * t, A * t
+            return 0.5 * A * t * t, A * t, A
         if t <= T - ta:
-            return 0.5 * A * ta * ta + V * (t - ta), V
+            return 0.5 * A * ta * ta + V * (t - ta), V, 0.0
         r = T - t
-        return 1.0 - 0.5 * A * r * r, A * r
+        return 1.0 - 0.5 * A * r * r, A * r, -A
 
-    def sample(self, t: float) -> tuple[FloatArray, FloatArray]:
-        """Joint positions [rad] and velocities [rad/s] at time ``t`` [s]; exactly ``q1`` from ``duration`` on."""
+    def sample(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Joint positions [rad], velocities [rad/s] and accelerations [rad/s^2] at time ``t`` [s]; exactly ``q1``
+        at rest from ``duration`` on."""
         if t >= self.duration:
-            return self.q1.copy(), np.zeros_like(self.q1)
-        s, ds = self.path(t)
+            return self.q1.copy(), np.zeros_like(self.q1), np.zeros_like(self.q1)
+        s, ds, dds = self.path(t)
         dq = self.q1 - self.q0
-        return self.q0 + s * dq, ds * dq
+        return self.q0 + s * dq, ds * dq, dds * dq
 
 
 def plan_movej(q0: Sequence[float] | FloatArray, q1: Sequence[float] | FloatArray, v: float, a: float,
