@@ -107,3 +107,43 @@ def plan_movej(q0: Sequence[float] | FloatArray, q1: Sequence[float] | FloatArra
         return MoveJ(start, end, s_acc * t_acc, s_acc, t_acc, 2.0 * t_acc)
     t_acc = s_vel / s_acc
     return MoveJ(start, end, s_vel, s_acc, t_acc, 1.0 / s_vel + t_acc)
+
+
+class MoveJReference:
+    """The controller's joint reference under ``movej`` commands: each move starts where the reference rests (the
+    end of the last one), and the reference is sampled once per control period.
+
+    Args:
+        q: the reference to start from, at rest [rad].
+        v_max, a_max: the joints' speed [rad/s] and acceleration [rad/s^2] caps (:func:`plan_movej`).
+    """
+
+    def __init__(self, q: Sequence[float] | FloatArray, v_max: Sequence[float], a_max: Sequence[float]) -> None:
+        self.q: FloatArray = np.array(q, dtype=float)  # the reference at the end of the last period [rad]
+        self.target: FloatArray = self.q.copy()  # destination of the current (or last) move [rad]
+        self.v_max, self.a_max = v_max, a_max
+        self.motion: MoveJ | None = None  # the move running, if any
+        self.t = 0.0  # time into it [s]
+
+    def begin(self, destination: Sequence[float] | FloatArray, v: float, a: float) -> MoveJ:
+        """Start ``movej(destination, a, v)`` from the reference; returns its profile (a move of zero length ends
+        at once)."""
+        motion = plan_movej(self.q, destination, v, a, self.v_max, self.a_max)
+        self.target = motion.q1.copy()
+        self.t = 0.0
+        self.motion = motion if motion.duration > 0.0 else None
+        if self.motion is None:
+            self.q = motion.q1.copy()
+        return motion
+
+    def advance(self, dt: float) -> tuple[FloatArray, FloatArray, FloatArray] | None:
+        """The reference ``dt`` [s] further into the running move: positions [rad], velocities [rad/s] and
+        accelerations [rad/s^2]; None at rest (the reference stays :attr:`q`)."""
+        if self.motion is None:
+            return None
+        self.t += dt
+        sample = self.motion.sample(self.t)
+        if self.t >= self.motion.duration:
+            self.motion = None
+        self.q = sample[0]
+        return sample
