@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ur3hanoi.robot.model import JointLimits
-from ur3hanoi.robot.movej import plan_movej
+from ur3hanoi.robot.movej import MoveJReference, plan_movej
 
 LIM = JointLimits.ur3()
 V_MAX, A_MAX = np.array(LIM.v_max), np.array(LIM.a_max)
@@ -110,3 +110,23 @@ def test_zero_length_move_is_instant():
     mv = plan_movej(q, q, 4.0, 4.0, V_MAX, A_MAX)
     assert mv.duration == 0.0
     np.testing.assert_array_equal(mv.sample(0.0)[0], q)
+
+
+def test_the_reference_runs_one_move_after_another_from_where_it_rests():
+    ref = MoveJReference(np.zeros(6), V_MAX, A_MAX)
+    q1 = np.array([0.5, -0.3, 0.2, 0.0, 0.1, -0.4])
+    first = ref.begin(q1, 4.0, 4.0)
+    assert ref.motion is first and first.duration > 0.0
+    samples = []
+    while (s := ref.advance(0.008)) is not None:
+        samples.append(s)
+    assert len(samples) == math.ceil(first.duration / 0.008)
+    np.testing.assert_array_equal(samples[-1][0], q1)  # the last sample is the destination, at rest
+    np.testing.assert_array_equal(samples[-1][1], np.zeros(6))
+    np.testing.assert_array_equal(ref.q, q1)
+    second = ref.begin(np.zeros(6), 4.0, 4.0)
+    np.testing.assert_array_equal(second.q0, q1)  # the next move starts where the last one ended
+    np.testing.assert_array_equal(ref.target, np.zeros(6))
+    assert ref.advance(0.008)[1].any()  # moving
+    still = MoveJReference(q1, V_MAX, A_MAX)
+    assert still.begin(q1, 4.0, 4.0).duration == 0.0 and still.motion is None and still.advance(0.008) is None
