@@ -21,12 +21,11 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-import pinocchio as pin
 
 from ur3hanoi.robot.model import JOINT_NAMES, Q_HOME_LAB
 from ur3hanoi.robot.registry import RobotDescription
 from ur3hanoi.robot.urdf import LINKS, link_inertias, link_shapes, ur_layout
-from ur3hanoi.sim.model import DEFAULT_TOOL, DRIVES, T_ee_tcp, cup_geometry, quat_wxyz
+from ur3hanoi.sim.model import DEFAULT_TOOL, DRIVES, T_ee_tcp, cup_geometry, quat_wxyz, rpy_quat
 
 _LINK_RGBA = {  # e-Series: blue joint caps, grey tubes
     "base_link": (0.35, 0.55, 0.8, 1.0), "shoulder_link": (0.35, 0.55, 0.8, 1.0),
@@ -71,7 +70,7 @@ def build_dh_robot_spec(robot: RobotDescription) -> mujoco.MjSpec:
     parent = base
     for i, jp in enumerate(ur_layout(robot)):
         body = parent.add_body(name=jp.child, pos=list(jp.xyz),
-                               quat=list(quat_wxyz(pin.rpy.rpyToMatrix(*jp.rpy))), gravcomp=1.0)
+                               quat=list(rpy_quat(jp.rpy)), gravcomp=1.0)
         inertia = inertias[i]
         body.explicitinertial = True
         body.mass, body.ipos, body.inertia = inertia.mass, list(inertia.com), list(inertia.diag)
@@ -88,7 +87,7 @@ def build_dh_robot_spec(robot: RobotDescription) -> mujoco.MjSpec:
 
     d6 = robot.dh.d[5]
     ee = parent.add_body(name="ee_link", pos=[0.0, d6, 0.0],
-                         quat=list(quat_wxyz(pin.rpy.rpyToMatrix(0.0, 0.0, math.pi / 2))))
+                         quat=list(rpy_quat((0.0, 0.0, math.pi / 2))))
     T = T_ee_tcp(DEFAULT_TOOL)
     cup = cup_geometry(T)
     cup_body = ee.add_body(name="suction_cup")
@@ -99,7 +98,7 @@ def build_dh_robot_spec(robot: RobotDescription) -> mujoco.MjSpec:
     cup_body.add_site(name="suction", pos=list(T.translation), quat=list(quat_wxyz(T.rotation)), size=[0.004, 0, 0],
                       rgba=[1, 0, 0, 1], group=4)
     parent.add_body(name="tool0", pos=[0.0, d6, 0.0],
-                    quat=list(quat_wxyz(pin.rpy.rpyToMatrix(-math.pi / 2, 0.0, 0.0))))
+                    quat=list(rpy_quat((-math.pi / 2, 0.0, 0.0))))
     spec.add_exclude(bodyname1=LINKS[0], bodyname2=LINKS[1])
     spec.add_key(name="home", qpos=list(Q_HOME_LAB), ctrl=list(Q_HOME_LAB))
     assert tuple(j.name for j in spec.joints) == JOINT_NAMES
