@@ -13,7 +13,7 @@ from tests.support.ros_support import final_slots, free_port, requires_ros, ros_
 from ur3hanoi.errors import PuzzleError, SuctionFaultError
 from ur3hanoi.interface.controller import StationDriver
 from ur3hanoi.interface.solve import run_lab_solve
-from ur3hanoi.interface.world import StationWorld
+from ur3hanoi.sim.world import MoveJWorld
 from ur3hanoi.tables.ik_table import generate_table
 
 
@@ -71,14 +71,14 @@ class SimArm:
         return f"DIGIN={fb.digin}, AIN0={fb.ain0:.2f} V"
 
 
-def slots(world: StationWorld) -> dict[int, tuple[int | None, int | None]]:
+def slots(world: MoveJWorld) -> dict[int, tuple[int | None, int | None]]:
     return {b.block: (b.tower, b.height) for b in world.blocks()}
 
 
 @pytest.mark.parametrize(("name", "start", "end"), [("lab_sim", 0, 2), ("lab_real", 1, 0)])
 def test_solves_in_world_time(name, start, end, request):
     station = request.getfixturevalue(name)
-    world = StationWorld(station, start, 3)
+    world = MoveJWorld(station, start, 3)
     driver = StationDriver(world)
     arm = SimArm(driver)
     result = run_lab_solve(arm, generate_table(station).q, station.q_home_array, start, end, 3)
@@ -90,7 +90,7 @@ def test_solves_in_world_time(name, start, end, request):
 
 
 def test_missing_block_halts_suction_off_at_home(lab_sim):
-    world = StationWorld(lab_sim, 0, 3, removed=1)
+    world = MoveJWorld(lab_sim, 0, 3, removed=1)
     arm = SimArm(StationDriver(world))
     with pytest.raises(SuctionFaultError) as err:
         run_lab_solve(arm, generate_table(lab_sim).q, lab_sim.q_home_array, 0, 2, 3)
@@ -104,7 +104,7 @@ def test_missing_block_halts_suction_off_at_home(lab_sim):
 
 
 def test_block_dropped_during_the_carry_halts(lab_sim):
-    world = StationWorld(lab_sim, 0, 3, drop_on_grasp=2)  # the third grasp: red, tower 3 -> tower 2
+    world = MoveJWorld(lab_sim, 0, 3, drop_on_grasp=2)  # the third grasp: red, tower 3 -> tower 2
     arm = SimArm(StationDriver(world))
     with pytest.raises(SuctionFaultError, match="suction fault in move 3/7: red block 3 was dropped while carrying "
                                                 "it from tower 3 to tower 2"):
@@ -115,7 +115,7 @@ def test_block_dropped_during_the_carry_halts(lab_sim):
 
 @pytest.mark.parametrize(("leg", "what"), [(1, "lift"), (2, "carry"), (3, "descent")])
 def test_block_lost_in_any_leg_with_a_block_halts(lab_sim, leg, what):
-    world = StationWorld(lab_sim, 0, 3)
+    world = MoveJWorld(lab_sim, 0, 3)
     arm = SimArm(StationDriver(world))
     arm.drop_on_watched_move = 3 + leg  # move 2 (its watched moves are 4, 5, 6)
     with pytest.raises(SuctionFaultError, match="suction fault in move 2/7: yellow block 2 was dropped while "
@@ -125,7 +125,7 @@ def test_block_lost_in_any_leg_with_a_block_halts(lab_sim, leg, what):
 
 
 def test_bad_table_shape_is_refused(lab_sim):
-    arm = SimArm(StationDriver(StationWorld(lab_sim, 0, 3)))
+    arm = SimArm(StationDriver(MoveJWorld(lab_sim, 0, 3)))
     with pytest.raises(PuzzleError, match=r"table shape \(3, 3, 6\) is invalid"):
         run_lab_solve(arm, np.zeros((3, 3, 6)), lab_sim.q_home_array, 0, 2, 3)
 

@@ -31,7 +31,7 @@ from ur3hanoi.sim import run_plan
 from ur3hanoi.sim.scene import slot_centers
 from ur3hanoi.station.calibration import Station
 
-MARGIN_M = 0.0025  # [m] half the executor's final check (SimConfig.place_tolerance, 5 mm)
+MARGIN_M = 0.0025  # [m] half the executor's final check (SimConfig.place_tolerance_m, 5 mm)
 
 
 def _tall(lab_real: Station, n_heights: int = 10) -> Station:

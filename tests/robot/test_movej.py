@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ur3hanoi.robot.model import JointLimits
-from ur3hanoi.robot.movej import plan_movej
+from ur3hanoi.robot.movej import MoveJReference, plan_movej
 
 LIM = JointLimits.ur3()
 V_MAX, A_MAX = np.array(LIM.v_max), np.array(LIM.a_max)
@@ -20,7 +20,7 @@ rates = st.floats(0.05, 10.0)
 
 def sampled(mv, n: int = 400) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     t = np.linspace(0.0, mv.duration, n)
-    qs, vs = zip(*(mv.sample(x) for x in t), strict=True)
+    qs, vs, _accs = zip(*(mv.sample(x) for x in t), strict=True)
     return t, np.array(qs), np.array(vs)
 
 
@@ -60,6 +60,24 @@ def test_acceleration_of_samples_within_caps():
     assert np.all(np.abs(vs) <= np.minimum(4.0, V_MAX) + 1e-9)
 
 
+@settings(max_examples=50, deadline=None)
+@given(angles, angles, rates, rates)
+def test_sampled_acceleration_is_the_rate_of_the_sampled_velocity(q0, q1, v, a):
+    """The reference acceleration the servo's feed-forward uses: over any interval, its mean (the trapezoid is
+    piecewise constant in acceleration: integrated exactly on a fine grid) is the change of velocity."""
+    mv = plan_movej(q0, q1, v, a, V_MAX, A_MAX)
+    if not 0.0 < mv.duration < 100.0:
+        return
+    t = np.linspace(-0.01, mv.duration + 0.01, 4001)
+    _qs, vs, accs = (np.array(x) for x in zip(*(mv.sample(x) for x in t), strict=True))
+    integral = np.cumsum(0.5 * (accs[1:] + accs[:-1]) * np.diff(t)[:, None], axis=0)
+    # Each of the (at most 4) acceleration steps costs at most one grid interval times the step's height.
+    tol = 4 * np.diff(t)[0] * mv.peak_acceleration + 1e-9
+    assert np.all(np.abs(vs[1:] - vs[0] - integral) <= tol)
+    assert np.all(np.abs(accs) <= mv.peak_acceleration * (1 + 1e-9) + 1e-12)
+    np.testing.assert_array_equal(mv.sample(mv.duration)[2], np.zeros(6))
+
+
 def test_long_move_lasts_distance_over_speed_plus_ramp():
     # The course's simulator: a move lasts about max|dq| / v; a trapezoid adds v / a for the ramps.
     q0 = np.zeros(6)
@@ -92,3 +110,23 @@ def test_zero_length_move_is_instant():
     mv = plan_movej(q, q, 4.0, 4.0, V_MAX, A_MAX)
     assert mv.duration == 0.0
     np.testing.assert_array_equal(mv.sample(0.0)[0], q)
+
+
+def test_the_reference_runs_one_move_after_another_from_where_it_rests():
+    ref = MoveJReference(np.zeros(6), V_MAX, A_MAX)
+    q1 = np.array([0.5, -0.3, 0.2, 0.0, 0.1, -0.4])
+    first = ref.begin(q1, 4.0, 4.0)
+    assert ref.motion is first and first.duration > 0.0
+    samples = []
+    while (s := ref.advance(0.008)) is not None:
+        samples.append(s)
+    assert len(samples) == math.ceil(first.duration / 0.008)
+    np.testing.assert_array_equal(samples[-1][0], q1)  # the last sample is the destination, at rest
+    np.testing.assert_array_equal(samples[-1][1], np.zeros(6))
+    np.testing.assert_array_equal(ref.q, q1)
+    second = ref.begin(np.zeros(6), 4.0, 4.0)
+    np.testing.assert_array_equal(second.q0, q1)  # the next move starts where the last one ended
+    np.testing.assert_array_equal(ref.target, np.zeros(6))
+    assert ref.advance(0.008)[1].any()  # moving
+    still = MoveJReference(q1, V_MAX, A_MAX)
+    assert still.begin(q1, 4.0, 4.0).duration == 0.0 and still.motion is None and still.advance(0.008) is None

@@ -12,7 +12,8 @@ from tests.support.sim_helpers import MAX_TRACKING_RAD, PAIRS, STATIONS, planned
 from ur3hanoi.errors import SimulationError, SuctionFaultError
 from ur3hanoi.hanoi import Move, solve_hanoi
 from ur3hanoi.plan import Phase
-from ur3hanoi.robot.model import N_JOINTS, JointLimits
+from ur3hanoi.robot.model import JointLimits
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.sim import Faults, JointTrace, SimResult, build_task_scene, run_plan
 from ur3hanoi.sim.diagnosis import displaced_blocks
 from ur3hanoi.station.calibration import Station

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from ur3hanoi.errors import SimulationError
-from ur3hanoi.robot.model import JOINT_NAMES, Q_HOME_LAB, urdf_path
+from ur3hanoi.robot.model import Q_HOME_LAB
+from ur3hanoi.robot.urdf import JOINT_NAMES, urdf_path
 from ur3hanoi.sim import DRIVES, SCENE_XML, UR3_XML, derive_ur3_mjcf, ur3_mesh_sources, warning_counts
 
 

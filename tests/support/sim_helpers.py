@@ -12,7 +12,7 @@ import numpy as np
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.hanoi import solve_hanoi
 from ur3hanoi.plan import Phase, Plan, PlanConfig, Trajectory, plan_solve
-from ur3hanoi.robot.model import N_JOINTS
+from ur3hanoi.robot.registry import N_JOINTS
 from ur3hanoi.station.calibration import Station, load_station
 from ur3hanoi.tables.ik_table import generate_table
 

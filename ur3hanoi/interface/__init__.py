@@ -3,13 +3,13 @@ middleware.
 
 The ROS 1 binding (:mod:`ur3hanoi.interface.ros1`, rospy) and the ROS 2 binding (:mod:`ur3hanoi.interface.ros2`, Cyclone
 DDS) share everything here and add only their transport. Nothing in this package imports rospy or a DDS library;
-importing the package imports nothing heavy (MuJoCo only with :mod:`~ur3hanoi.interface.world`).
+importing the package imports nothing heavy (MuJoCo only with the simulated arm, :class:`ur3hanoi.sim.MoveJWorld`).
 
 - :mod:`~ur3hanoi.interface.errors`: the errors (:class:`~ur3hanoi.interface.errors.RosError`,
   :class:`~ur3hanoi.interface.errors.CommandError`).
 - :mod:`~ur3hanoi.interface.command`: which command messages the station executes or refuses.
-- :mod:`~ur3hanoi.robot.movej`: the UR controller's ``movej`` profile (synchronised trapezoid, v/a capped).
-- :mod:`~ur3hanoi.interface.world`: the MuJoCo station stepped one control period at a time (servo, suction, blocks).
+- the simulated arm is :class:`ur3hanoi.sim.MoveJWorld` (:mod:`ur3hanoi.sim.world`): ``movej`` profiles
+  (:mod:`ur3hanoi.robot.movej`) through the servo law ``ur3hanoi solve`` uses.
 - :mod:`~ur3hanoi.interface.controller`: the command FIFO, ``isReady`` and the settle measurements.
 - :mod:`~ur3hanoi.interface.lograte`: log lines a flood cannot multiply (one per topic and second, with counts).
 - :mod:`~ur3hanoi.interface.server`: the station node's scaffolding (options, bounded inbox, real-time loop,

@@ -13,7 +13,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ur3hanoi.interface.errors import CommandError
-from ur3hanoi.robot.model import N_JOINTS, JointLimits
+from ur3hanoi.robot.model import JointLimits
+from ur3hanoi.robot.registry import N_JOINTS
 
 
 @dataclass(frozen=True)

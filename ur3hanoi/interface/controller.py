@@ -1,6 +1,6 @@
 """The station's controller logic: accept or refuse commands, execute them in order, measure how the arm settles.
 
-:class:`StationDriver` sits between the ROS callbacks and :class:`~ur3hanoi.interface.world.StationWorld`. Accepted
+:class:`StationDriver` sits between the ROS callbacks and :class:`~ur3hanoi.sim.world.MoveJWorld`. Accepted
 commands wait in a FIFO and each starts when the previous motion's profile has ended (a controller's motion
 queue); the lab's ``move_arm`` re-publishes its command every 5 s while waiting, which then costs a zero-length
 move, never a jump. Every executed command is recorded with its duration, the time the arm needed to come within
@@ -28,8 +28,8 @@ from typing import Any
 
 from ur3hanoi.interface.command import MoveCommand, parse_command
 from ur3hanoi.interface.errors import CommandError
-from ur3hanoi.interface.world import StationWorld
 from ur3hanoi.robot.movej import plan_movej
+from ur3hanoi.sim.world import MoveJWorld
 
 MAX_MOVE_S = 60.0
 """Longest ``movej`` [s] the station accepts (see the module docstring)."""
@@ -75,7 +75,7 @@ class Rejection:
 
 
 class StationDriver:
-    """Command FIFO and records over a :class:`StationWorld` (see the module docstring).
+    """Command FIFO and records over a :class:`~ur3hanoi.sim.world.MoveJWorld` (see the module docstring).
 
     Args:
         world: the simulated station.
@@ -85,7 +85,7 @@ class StationDriver:
         records_kept: the last this many executed and refused commands are kept in full.
     """
 
-    def __init__(self, world: StationWorld, max_queue: int = 100, min_rest_s: float = 0.2,
+    def __init__(self, world: MoveJWorld, max_queue: int = 100, min_rest_s: float = 0.2,
                  max_move_s: float = MAX_MOVE_S, records_kept: int = RECORDS_KEPT) -> None:
         self.world = world
         self.max_queue = max_queue
@@ -160,7 +160,7 @@ class StationDriver:
             if self._current is not None:
                 self._fold(self._current)
             command = self.queue.popleft()
-            motion = w.begin(command)
+            motion = w.begin(command.destination, command.v, command.a, command.io_0)
             v, acc = motion.peak_velocity, motion.peak_acceleration
             self._current = ExecutedMove(command, w.time, motion.duration, float(v.max()), float(acc.max()))
             self.executed.append(self._current)

@@ -1,6 +1,6 @@
 """The station node's scaffolding, whatever the middleware: options, inbox, control loop, report, signals.
 
-:class:`StationCore` holds the simulated station (:class:`~ur3hanoi.interface.world.StationWorld` driven by a
+:class:`StationCore` holds the simulated station (:class:`~ur3hanoi.sim.world.MoveJWorld` driven by a
 :class:`~ur3hanoi.interface.controller.StationDriver`) and runs it in real time; a transport binding
 (:class:`ur3hanoi.interface.ros1.server.RosStation` on rospy, :class:`ur3hanoi.interface.ros2.server.Ros2Station` on
 Cyclone DDS) subclasses it, opens its topics and passes what arrives to :meth:`StationCore.on_command` (and
@@ -143,7 +143,8 @@ class StationCore:
                  report_out: Callable[[str], None]) -> None:
         from ur3hanoi.interface.controller import StationDriver
         from ur3hanoi.interface.lograte import RateLimitedLog
-        from ur3hanoi.interface.world import StationWorld, WorldConfig
+        from ur3hanoi.sim.config import SimConfig
+        from ur3hanoi.sim.world import MoveJWorld
         from ur3hanoi.station.calibration import load_station, with_suction_profile
 
         self.options = opts = options
@@ -159,8 +160,8 @@ class StationCore:
             raise RosError(f"rate {opts.rate_hz} Hz is invalid: expected 50..500 Hz (the period a multiple of 2 ms)")
         if opts.drop_on_grasp is not None and opts.drop_on_grasp < 0:
             raise RosError(f"grasp {opts.drop_on_grasp + 1} is invalid: expected a grasp number >= 1")
-        config = WorldConfig(period_s=1.0 / opts.rate_hz, seed=opts.seed)
-        self.world = StationWorld(self.station, opts.start, n_blocks, opts.removed, config, opts.drop_on_grasp)
+        config = SimConfig(period_s=1.0 / opts.rate_hz, seed=opts.seed)
+        self.world = MoveJWorld(self.station, opts.start, n_blocks, opts.removed, config, opts.drop_on_grasp)
         self.driver = StationDriver(self.world)
         self.timing = LoopTiming(config.period_s)
         self.reports_written = 0

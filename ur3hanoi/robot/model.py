@@ -26,7 +26,7 @@ from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import Ur3HanoiError
 from ur3hanoi.robot.chain import UrdfChain, parse_chain, rigid_inverse, se3_act_inv
 from ur3hanoi.robot.registry import CB3_CONTROL_PERIOD_S, N_JOINTS, UR3, DHParameters, RobotDescription
-from ur3hanoi.robot.urdf import FLANGE_FRAMES, JOINT_NAMES, ToolOffset, package_dir, urdf_path, urdf_text
+from ur3hanoi.robot.urdf import FLANGE_FRAMES, JOINT_NAMES, ToolOffset, urdf_text
 
 if TYPE_CHECKING:
     import pinocchio as pin
@@ -259,19 +259,12 @@ def load_ur3(tool: ToolOffset | None = None, limits: JointLimits | None = None,
     return Ur3Model(tool, limits, robot)
 
 
-# JOINT_NAMES, ToolOffset, package_dir, urdf_path (homes: ur3hanoi.robot.urdf) and N_JOINTS (ur3hanoi.robot.registry)
-# are listed here too while sim/ and interface/ still import them from this module (issue 27).
 __all__ = [
     "H_BASELINK_BASE",
     "H_BASE_BASELINK",
-    "JOINT_NAMES",
-    "N_JOINTS",
     "Q_HOME_LAB",
     "T_BASELINK_BASE",
     "JointLimits",
-    "ToolOffset",
     "Ur3Model",
     "load_ur3",
-    "package_dir",
-    "urdf_path",
 ]

@@ -61,27 +61,29 @@ class MoveJ:
         """Acceleration of each joint during the ramps [rad/s^2] (absolute value)."""
         return np.abs(self.q1 - self.q0) * self.s_acc
 
-    def path(self, t: float) -> tuple[float, float]:
-        """The path parameter ``s`` and its rate ``ds/dt`` [1/s] at time ``t`` [s] (clamped to [0, duration])."""
+    def path(self, t: float) -> tuple[float, float, float]:
+        """The path parameter ``s``, its rate ``ds/dt`` [1/s] and its acceleration ``d2s/dt2`` [1/s^2] at time
+        ``t`` [s] (clamped to [0, duration]; the acceleration steps at the ramps' ends, and is zero at rest)."""
         T, ta, A, V = self.duration, self.t_acc, self.s_acc, self.s_vel
         if t <= 0.0 or T <= 0.0:
-            return (1.0, 0.0) if T <= 0.0 else (0.0, 0.0)
+            return (1.0, 0.0, 0.0) if T <= 0.0 else (0.0, 0.0, 0.0)
         if t >= T:
-            return 1.0, 0.0
+            return 1.0, 0.0, 0.0
         if t < ta:
-            return 0.5 * A * t * t, A * t
+            return 0.5 * A * t * t, A * t, A
         if t <= T - ta:
-            return 0.5 * A * ta * ta + V * (t - ta), V
+            return 0.5 * A * ta * ta + V * (t - ta), V, 0.0
         r = T - t
-        return 1.0 - 0.5 * A * r * r, A * r
+        return 1.0 - 0.5 * A * r * r, A * r, -A
 
-    def sample(self, t: float) -> tuple[FloatArray, FloatArray]:
-        """Joint positions [rad] and velocities [rad/s] at time ``t`` [s]; exactly ``q1`` from ``duration`` on."""
+    def sample(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Joint positions [rad], velocities [rad/s] and accelerations [rad/s^2] at time ``t`` [s]; exactly ``q1``
+        at rest from ``duration`` on."""
         if t >= self.duration:
-            return self.q1.copy(), np.zeros_like(self.q1)
-        s, ds = self.path(t)
+            return self.q1.copy(), np.zeros_like(self.q1), np.zeros_like(self.q1)
+        s, ds, dds = self.path(t)
         dq = self.q1 - self.q0
-        return self.q0 + s * dq, ds * dq
+        return self.q0 + s * dq, ds * dq, dds * dq
 
 
 def plan_movej(q0: Sequence[float] | FloatArray, q1: Sequence[float] | FloatArray, v: float, a: float,
@@ -105,3 +107,43 @@ def plan_movej(q0: Sequence[float] | FloatArray, q1: Sequence[float] | FloatArra
         return MoveJ(start, end, s_acc * t_acc, s_acc, t_acc, 2.0 * t_acc)
     t_acc = s_vel / s_acc
     return MoveJ(start, end, s_vel, s_acc, t_acc, 1.0 / s_vel + t_acc)
+
+
+class MoveJReference:
+    """The controller's joint reference under ``movej`` commands: each move starts where the reference rests (the
+    end of the last one), and the reference is sampled once per control period.
+
+    Args:
+        q: the reference to start from, at rest [rad].
+        v_max, a_max: the joints' speed [rad/s] and acceleration [rad/s^2] caps (:func:`plan_movej`).
+    """
+
+    def __init__(self, q: Sequence[float] | FloatArray, v_max: Sequence[float], a_max: Sequence[float]) -> None:
+        self.q: FloatArray = np.array(q, dtype=float)  # the reference at the end of the last period [rad]
+        self.target: FloatArray = self.q.copy()  # destination of the current (or last) move [rad]
+        self.v_max, self.a_max = v_max, a_max
+        self.motion: MoveJ | None = None  # the move running, if any
+        self.t = 0.0  # time into it [s]
+
+    def begin(self, destination: Sequence[float] | FloatArray, v: float, a: float) -> MoveJ:
+        """Start ``movej(destination, a, v)`` from the reference; returns its profile (a move of zero length ends
+        at once)."""
+        motion = plan_movej(self.q, destination, v, a, self.v_max, self.a_max)
+        self.target = motion.q1.copy()
+        self.t = 0.0
+        self.motion = motion if motion.duration > 0.0 else None
+        if self.motion is None:
+            self.q = motion.q1.copy()
+        return motion
+
+    def advance(self, dt: float) -> tuple[FloatArray, FloatArray, FloatArray] | None:
+        """The reference ``dt`` [s] further into the running move: positions [rad], velocities [rad/s] and
+        accelerations [rad/s^2]; None at rest (the reference stays :attr:`q`)."""
+        if self.motion is None:
+            return None
+        self.t += dt
+        sample = self.motion.sample(self.t)
+        if self.t >= self.motion.duration:
+            self.motion = None
+        self.q = sample[0]
+        return sample

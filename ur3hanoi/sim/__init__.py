@@ -10,14 +10,21 @@ Modules, in order of dependency (each imports only the ones above it):
   :func:`build_task_spec`, :func:`build_task_scene`, :class:`TaskScene`), the blocks' start slots and names.
 - :mod:`~ur3hanoi.sim.suction`: the emulated vacuum gripper and its ``gripper_input`` feedback
   (:class:`SuctionConfig`, :class:`SuctionCup`, :class:`GripperInput`).
+- :mod:`~ur3hanoi.sim.config`: the settings of a simulated lab, one type for both drivers (:class:`SimConfig`).
+- :mod:`~ur3hanoi.sim.servo`: the one servo law of the simulated UR controller (interpolation, velocity and
+  acceleration feed-forward), through which both drivers step the scene (:class:`~ur3hanoi.sim.servo.JointServo`).
 - :mod:`~ur3hanoi.sim.halt`: the motion of a halt (:class:`HaltProfile`, :data:`DEFAULT_HALT_PROFILE`: Ruckig).
 - :mod:`~ur3hanoi.sim.result`: what a run reports (:class:`SimResult`, :class:`FeedbackEvent`,
   :class:`FinalBlock`, :class:`DisplacedBlock`, :class:`JointTrace`).
 - :mod:`~ur3hanoi.sim.diagnosis`: what a halt says happened: the block actually missing, a grasp the cup did not
   reach, blocks knocked out of place after the halt (:class:`DisplacedBlock`).
-- :mod:`~ur3hanoi.sim.executor`: :func:`run_plan` streams a :class:`ur3hanoi.plan.Plan`, checks the suction like
-  the lab program, halts on a fault (raising :class:`ur3hanoi.errors.SuctionFaultError` with the result) and
-  verifies the final block positions (:class:`Faults`, :class:`SimConfig`).
+- :mod:`~ur3hanoi.sim.verify`: where every block is, whether the arm is home, ``solve``'s final check.
+- :mod:`~ur3hanoi.sim.suction_check`: the lab program's suction check while a plan streams.
+- :mod:`~ur3hanoi.sim.executor`: ``solve``'s driver: :func:`run_plan` streams a :class:`ur3hanoi.plan.Plan`, checks
+  the suction like the lab program, halts on a fault (raising :class:`ur3hanoi.errors.SuctionFaultError` with the
+  result) and verifies the final block positions (:class:`Faults`).
+- :mod:`~ur3hanoi.sim.world`: the ROS servers' driver: :class:`MoveJWorld` runs ``movej`` commands one control
+  period at a time (servo, suction, blocks, :class:`WorldEvent`).
 - :mod:`~ur3hanoi.sim.render`: offscreen frames/video and the interactive viewer (:class:`CameraConfig`,
   :class:`OffscreenRecorder`, :data:`VIDEO_FORMATS`, :func:`check_video_path`, :class:`ViewerSink`,
   :func:`display_available`).
@@ -29,7 +36,8 @@ Joint values are the controller/DH convention (they equal the URDF's, see :mod:`
 Numbering: internally 0-based (towers, heights, blocks, moves); messages and JSON are 1-based like the lab.
 """
 
-from ur3hanoi.sim.executor import Faults, FrameSink, ProgressFn, SimConfig, run_plan
+from ur3hanoi.sim.config import SimConfig
+from ur3hanoi.sim.executor import Faults, FrameSink, ProgressFn, run_plan
 from ur3hanoi.sim.halt import DEFAULT_HALT_PROFILE, HaltProfile
 from ur3hanoi.sim.model import (
     DRIVES,
@@ -63,6 +71,7 @@ from ur3hanoi.sim.scene import (
     warning_counts,
 )
 from ur3hanoi.sim.suction import GripperInput, SuctionConfig, SuctionCup
+from ur3hanoi.sim.world import MoveJWorld, WorldEvent
 
 __all__ = [
     "DEFAULT_HALT_PROFILE",
@@ -81,6 +90,7 @@ __all__ = [
     "HaltProfile",
     "JointDrive",
     "JointTrace",
+    "MoveJWorld",
     "OffscreenRecorder",
     "ProgressFn",
     "SceneConfig",
@@ -91,6 +101,7 @@ __all__ = [
     "TaskScene",
     "VideoFormat",
     "ViewerSink",
+    "WorldEvent",
     "block_name",
     "build_task_scene",
     "build_task_spec",

@@ -22,12 +22,11 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-import pinocchio as pin
 
 from ur3hanoi.robot.model import Q_HOME_LAB
 from ur3hanoi.robot.registry import RobotDescription
 from ur3hanoi.robot.urdf import JOINT_NAMES, LINKS, fixed_frames, link_inertias, link_shapes, ur_layout
-from ur3hanoi.sim.model import DEFAULT_TOOL, DRIVES, T_ee_tcp, cup_geometry, quat_wxyz
+from ur3hanoi.sim.model import DEFAULT_TOOL, DRIVES, T_ee_tcp, cup_geometry, quat_wxyz, rpy_quat
 
 _LINK_RGBA = {  # e-Series: blue joint caps, grey tubes
     "base_link": (0.35, 0.55, 0.8, 1.0), "shoulder_link": (0.35, 0.55, 0.8, 1.0),
@@ -72,7 +71,7 @@ def build_dh_robot_spec(robot: RobotDescription) -> mujoco.MjSpec:
     parent = base
     for i, jp in enumerate(ur_layout(robot)):
         body = parent.add_body(name=jp.child, pos=list(jp.xyz),
-                               quat=list(quat_wxyz(pin.rpy.rpyToMatrix(*jp.rpy))), gravcomp=1.0)
+                               quat=list(rpy_quat(jp.rpy)), gravcomp=1.0)
         inertia = inertias[i]
         body.explicitinertial = True
         body.mass, body.ipos, body.inertia = inertia.mass, list(inertia.com), list(inertia.diag)
@@ -88,8 +87,7 @@ def build_dh_robot_spec(robot: RobotDescription) -> mujoco.MjSpec:
         parent = body
 
     fixed = {f.child: f for f in fixed_frames(robot)}
-    ee = parent.add_body(name="ee_link", pos=list(fixed["ee_link"].xyz),
-                         quat=list(quat_wxyz(pin.rpy.rpyToMatrix(*fixed["ee_link"].rpy))))
+    ee = parent.add_body(name="ee_link", pos=list(fixed["ee_link"].xyz), quat=list(rpy_quat(fixed["ee_link"].rpy)))
     T = T_ee_tcp(DEFAULT_TOOL)
     cup = cup_geometry(T)
     cup_body = ee.add_body(name="suction_cup")
@@ -99,8 +97,7 @@ def build_dh_robot_spec(robot: RobotDescription) -> mujoco.MjSpec:
                           conaffinity=0, mass=0.0, rgba=[0.15, 0.15, 0.15, 1.0], group=2)
     cup_body.add_site(name="suction", pos=list(T.translation), quat=list(quat_wxyz(T.rotation)), size=[0.004, 0, 0],
                       rgba=[1, 0, 0, 1], group=4)
-    parent.add_body(name="tool0", pos=list(fixed["tool0"].xyz),
-                    quat=list(quat_wxyz(pin.rpy.rpyToMatrix(*fixed["tool0"].rpy))))
+    parent.add_body(name="tool0", pos=list(fixed["tool0"].xyz), quat=list(rpy_quat(fixed["tool0"].rpy)))
     spec.add_exclude(bodyname1=LINKS[0], bodyname2=LINKS[1])
     spec.add_key(name="home", qpos=list(Q_HOME_LAB), ctrl=list(Q_HOME_LAB))
     assert tuple(j.name for j in spec.joints) == JOINT_NAMES

@@ -27,13 +27,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree
 
+import mujoco
 import numpy as np
 import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import SimulationError
 from ur3hanoi.io.resources import robot_dir
-from ur3hanoi.robot.model import JOINT_NAMES, Q_HOME_LAB, ToolOffset, load_ur3, package_dir, urdf_path
+from ur3hanoi.robot.model import Q_HOME_LAB, load_ur3
+from ur3hanoi.robot.urdf import JOINT_NAMES, ToolOffset, package_dir, urdf_path
 
 ROBOT_DIR = robot_dir()
 UR3_XML = ROBOT_DIR / "ur3.xml"
@@ -105,15 +107,18 @@ def _vec(v: Sequence[float] | FloatArray) -> str:
 
 
 def quat_wxyz(R: FloatArray) -> FloatArray:
-    """Rotation matrix -> unit quaternion (w, x, y, z) with w >= 0 (MuJoCo's order)."""
-    q = pin.Quaternion(np.asarray(R, dtype=float))
-    q.normalize()
-    out = np.array([q.w, q.x, q.y, q.z])
-    return -out if out[0] < 0 else out
+    """Rotation matrix -> unit quaternion (w, x, y, z) with w >= 0 (MuJoCo's order; :func:`mujoco.mju_mat2Quat`)."""
+    q = np.zeros(4)
+    mujoco.mju_mat2Quat(q, np.ascontiguousarray(R, dtype=float).reshape(9))
+    return -q if q[0] < 0 else q
 
 
-def _rpy_quat(rpy: Sequence[float]) -> FloatArray:
-    return quat_wxyz(pin.rpy.rpyToMatrix(*[float(a) for a in rpy]))
+def rpy_quat(rpy: Sequence[float]) -> FloatArray:
+    """URDF roll-pitch-yaw [rad] (fixed axes x, y, z) -> unit quaternion (w, x, y, z) with w >= 0
+    (:func:`mujoco.mju_euler2Quat`, sequence ``XYZ``)."""
+    q = np.zeros(4)
+    mujoco.mju_euler2Quat(q, np.asarray(rpy, dtype=float), "XYZ")
+    return -q if q[0] < 0 else q
 
 
 def _find(el: ElementTree.Element, path: str) -> ElementTree.Element:
@@ -145,7 +150,7 @@ def _pose_attrs(xyz: Sequence[float], rpy: Sequence[float]) -> str:
     if any(abs(v) > 0 for v in xyz):
         out += f' pos="{_vec(xyz)}"'
     if any(abs(v) > 0 for v in rpy):
-        out += f' quat="{_vec(_rpy_quat(rpy))}"'
+        out += f' quat="{_vec(rpy_quat(rpy))}"'
     return out
 
 
@@ -167,95 +172,92 @@ def T_ee_tcp(tool: ToolOffset) -> pin.SE3:
     return load_ur3(tool).T_flange_tcp("ee_link")
 
 
-def derive_ur3_mjcf(urdf: Path | None = None) -> str:
-    """The text of ``robots/universal_robots_ur3/ur3.xml``, derived deterministically from ``ur3_robot.urdf``.
+def _inertial(link: ElementTree.Element, pad: str) -> list[str]:
+    """The ``<inertial>`` line of a URDF link with mass (none for a frame-only link)."""
+    inertial = link.find("inertial")
+    mass = float(_attr(_find(inertial, "mass"), "value")) if inertial is not None else 0.0
+    if inertial is None or mass <= 0:
+        return []
+    xyz, rpy = _origin(inertial.find("origin"))
+    inertia = _find(inertial, "inertia").attrib
+    full = [float(inertia[k]) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")]
+    inert = f'diaginertia="{_vec(full[:3])}"' if not any(full[3:]) else f'fullinertia="{_vec(full)}"'
+    return [f'{pad}<inertial pos="{_vec(xyz)}"{_pose_attrs([0.0, 0.0, 0.0], rpy)} mass="{_g(mass)}" {inert}/>']
 
-    Changes from the URDF (see ``robots/universal_robots_ur3/README.md``): visual ``.dae`` meshes dropped and the
-    collision STLs used as visuals too; ``ee_link``'s 1 cm collision box replaced by a non-colliding suction cup
-    body with the ``suction`` site (lab_sim tool by default); the ``world`` link dropped (``base_link`` is the root
-    body); armature, position actuators with datasheet torque limits, gravity compensation on the moving links, the
-    ``base_link``/``shoulder_link`` contact excluded, a ``home`` keyframe.
-    """
-    path = urdf if urdf is not None else urdf_path()
-    root = ElementTree.parse(path).getroot()
-    links = {lk.get("name"): lk for lk in root.findall("link")}
-    children: dict[str, list[ElementTree.Element]] = {}
-    for j in root.findall("joint"):
-        children.setdefault(_attr(_find(j, "parent"), "link"), []).append(j)
-    meshes: list[str] = []
 
-    def link_body(name: str, depth: int, joint: ElementTree.Element | None) -> list[str]:
+def _joint(joint: ElementTree.Element, pad: str) -> str:
+    """The ``<joint>`` line of a revolute URDF joint, in its drive class with the URDF's axis and range."""
+    axis = [float(v) for v in _attr(_find(joint, "axis"), "xyz").split()]
+    lim = _find(joint, "limit")
+    lo, hi = float(_attr(lim, "lower")), float(_attr(lim, "upper"))
+    name = _attr(joint, "name")
+    return (f'{pad}<joint name="{name}" class="{_JOINT_CLASS[name].split("_")[0]}" axis="{_vec(axis)}" '
+            f'range="{_g(lo)} {_g(hi)}"/>')
+
+
+def _suction_cup(pad: str) -> list[str]:
+    """The ``suction_cup`` body of ``ee_link``: the cup's bracket and cylinder, and the ``suction`` site at the
+    default tool's TCP."""
+    T = T_ee_tcp(DEFAULT_TOOL)
+    cup = cup_geometry(T)
+    return [
+        f'{pad}<body name="suction_cup">',
+        f'{pad}  <geom name="suction_bracket" class="suction" type="capsule" size="0.006" fromto="{cup["bracket"]}"/>',
+        f'{pad}  <geom name="suction_cup" class="suction" type="cylinder" size="0.009" fromto="{cup["cup"]}"/>',
+        f'{pad}  <site name="suction" pos="{_vec(T.translation)}" quat="{_vec(quat_wxyz(T.rotation))}"/>',
+        f"{pad}</body>",
+    ]
+
+
+@dataclass(frozen=True)
+class _UrdfTree:
+    """A URDF's links by name and each link's child joints; :meth:`body` writes a link's ``<body>`` subtree."""
+
+    links: dict[str | None, ElementTree.Element]
+    children: dict[str, list[ElementTree.Element]]
+
+    @classmethod
+    def parse(cls, path: Path) -> _UrdfTree:
+        root = ElementTree.parse(path).getroot()
+        children: dict[str, list[ElementTree.Element]] = {}
+        for j in root.findall("joint"):
+            children.setdefault(_attr(_find(j, "parent"), "link"), []).append(j)
+        return cls({lk.get("name"): lk for lk in root.findall("link")}, children)
+
+    def body(self, name: str, depth: int, joint: ElementTree.Element | None, meshes: list[str]) -> list[str]:
+        """The ``<body>`` lines of link ``name`` reached through ``joint`` (None: the root), indented ``depth``
+        levels, and of its descendants; appends the collision meshes used to ``meshes``."""
         pad = "  " * depth
-        link = links[name]
-        attrs = f'name="{name}"'
-        if joint is not None:
-            xyz, rpy = _origin(joint.find("origin"))
-            attrs += _pose_attrs(xyz, rpy)
+        link = self.links[name]
+        attrs = f'name="{name}"' + ("" if joint is None else _pose_attrs(*_origin(joint.find("origin"))))
         moving = joint is not None and joint.get("type") == "revolute"
         if name == "base_link":
             attrs += ' childclass="ur3"'
         elif moving:
-            # Gravity compensation stands in for the UR controller's own model-based compensation.
-            attrs += ' gravcomp="1"'
-        lines = [f"{pad}<body {attrs}>"]
-        inertial = link.find("inertial")
-        mass = float(_attr(_find(inertial, "mass"), "value")) if inertial is not None else 0.0
-        if inertial is not None and mass > 0:
-            xyz, rpy = _origin(inertial.find("origin"))
-            inertia = _find(inertial, "inertia").attrib
-            full = [float(inertia[k]) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")]
-            inert = (f'diaginertia="{_vec(full[:3])}"' if not any(full[3:])
-                     else f'fullinertia="{_vec(full)}"')
-            lines.append(f'{pad}  <inertial pos="{_vec(xyz)}"'
-                         f'{_pose_attrs([0.0, 0.0, 0.0], rpy)} mass="{_g(mass)}" {inert}/>')
-        if moving:
-            assert joint is not None
-            axis = [float(v) for v in _attr(_find(joint, "axis"), "xyz").split()]
-            lim = _find(joint, "limit")
-            lo, hi = float(_attr(lim, "lower")), float(_attr(lim, "upper"))
-            jname = _attr(joint, "name")
-            lines.append(f'{pad}  <joint name="{jname}" class="{_JOINT_CLASS[jname].split("_")[0]}" '
-                         f'axis="{_vec(axis)}" range="{_g(lo)} {_g(hi)}"/>')
+            attrs += ' gravcomp="1"'  # stands in for the UR controller's own model-based gravity compensation
+        lines = [f"{pad}<body {attrs}>", *_inertial(link, pad + "  ")]
+        if joint is not None and moving:
+            lines.append(_joint(joint, pad + "  "))
         for col in link.findall("collision"):
             mesh = col.find("geometry/mesh")
             if mesh is None:
                 continue  # ee_link's 1 cm box: replaced by the suction cup below
-            stem = Path(mesh.get("filename", "")).stem
-            meshes.append(stem)
-            xyz, rpy = _origin(col.find("origin"))
-            lines.append(f'{pad}  <geom name="{name}_mesh" mesh="{stem}"{_pose_attrs(xyz, rpy)}/>')
+            meshes.append(Path(mesh.get("filename", "")).stem)
+            lines.append(f'{pad}  <geom name="{name}_mesh" mesh="{meshes[-1]}"'
+                         f'{_pose_attrs(*_origin(col.find("origin")))}/>')
         if name == "ee_link":
-            T = T_ee_tcp(DEFAULT_TOOL)
-            cup = cup_geometry(T)
-            lines += [
-                f'{pad}  <body name="suction_cup">',
-                f'{pad}    <geom name="suction_bracket" class="suction" type="capsule" size="0.006" '
-                f'fromto="{cup["bracket"]}"/>',
-                f'{pad}    <geom name="suction_cup" class="suction" type="cylinder" size="0.009" '
-                f'fromto="{cup["cup"]}"/>',
-                f'{pad}    <site name="suction" pos="{_vec(T.translation)}" quat="{_vec(quat_wxyz(T.rotation))}"/>',
-                f"{pad}  </body>",
-            ]
-        for j in children.get(name, []):
-            lines += link_body(_attr(_find(j, "child"), "link"), depth + 1, j)
+            lines += _suction_cup(pad + "  ")
+        for j in self.children.get(name, []):
+            lines += self.body(_attr(_find(j, "child"), "link"), depth + 1, j, meshes)
         if len(lines) == 1:  # a frame-only link (base, tool0): self-closing
             return [lines[0].removesuffix(">") + "/>"]
-        lines.append(f"{pad}</body>")
-        return lines
+        return [*lines, f"{pad}</body>"]
 
-    body = link_body("base_link", 2, None)
+
+def _defaults() -> list[str]:
+    """The ``<default>`` section: link geoms and sites, the drive classes (:data:`DRIVES`), the suction cup's."""
     d3, d1 = DRIVES["size3"], DRIVES["size1"]
-    home = _vec(Q_HOME_LAB)
-    actuators = [
-        f'    <position name="{j.removesuffix("_joint")}" joint="{j}" class="{_JOINT_CLASS[j]}"/>' for j in JOINT_NAMES
-    ]
-    mesh_assets = [f'    <mesh name="{m}" file="{m}.stl"/>' for m in meshes]
-    text = [
-        '<mujoco model="ur3">',
-        f"  <!-- Generated by `python -m ur3hanoi.sim` from {SOURCE_PACKAGE} ur_description/urdf/ur3_robot.urdf.",
-        "       Do not edit by hand: change ur3hanoi.sim.derive_ur3_mjcf and rerun the script. -->",
-        '  <compiler angle="radian" meshdir="assets" autolimits="true"/>',
-        '  <option integrator="implicitfast" timestep="0.002"/>',
+    return [
         "  <default>",
         '    <default class="ur3">',
         "      <!-- contype 2 / conaffinity 1: the links hit the table and blocks (contype 1) but not each other:",
@@ -281,9 +283,31 @@ def derive_ur3_mjcf(urdf: Path | None = None) -> str:
         "      </default>",
         "    </default>",
         "  </default>",
+    ]
+
+
+def derive_ur3_mjcf(urdf: Path | None = None) -> str:
+    """The text of ``robots/universal_robots_ur3/ur3.xml``, derived deterministically from ``ur3_robot.urdf``.
+
+    Changes from the URDF (see ``robots/universal_robots_ur3/README.md``): visual ``.dae`` meshes dropped and the
+    collision STLs used as visuals too; ``ee_link``'s 1 cm collision box replaced by a non-colliding suction cup
+    body with the ``suction`` site (lab_sim tool by default); the ``world`` link dropped (``base_link`` is the root
+    body); armature, position actuators with datasheet torque limits, gravity compensation on the moving links, the
+    ``base_link``/``shoulder_link`` contact excluded, a ``home`` keyframe.
+    """
+    meshes: list[str] = []
+    body = _UrdfTree.parse(urdf if urdf is not None else urdf_path()).body("base_link", 2, None, meshes)
+    home = _vec(Q_HOME_LAB)
+    text = [
+        '<mujoco model="ur3">',
+        f"  <!-- Generated by `python -m ur3hanoi.sim` from {SOURCE_PACKAGE} ur_description/urdf/ur3_robot.urdf.",
+        "       Do not edit by hand: change ur3hanoi.sim.derive_ur3_mjcf and rerun the script. -->",
+        '  <compiler angle="radian" meshdir="assets" autolimits="true"/>',
+        '  <option integrator="implicitfast" timestep="0.002"/>',
+        *_defaults(),
         "",
         "  <asset>",
-        *mesh_assets,
+        *(f'    <mesh name="{m}" file="{m}.stl"/>' for m in meshes),
         "  </asset>",
         "",
         "  <worldbody>",
@@ -296,7 +320,8 @@ def derive_ur3_mjcf(urdf: Path | None = None) -> str:
         "  </contact>",
         "",
         "  <actuator>",
-        *actuators,
+        *(f'    <position name="{j.removesuffix("_joint")}" joint="{j}" class="{_JOINT_CLASS[j]}"/>'
+          for j in JOINT_NAMES),
         "  </actuator>",
         "",
         "  <keyframe>",

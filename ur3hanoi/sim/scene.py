@@ -24,7 +24,8 @@ import pinocchio as pin
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import SimulationError
 from ur3hanoi.hanoi import block_colour
-from ur3hanoi.robot.model import JOINT_NAMES, T_BASELINK_BASE
+from ur3hanoi.robot.model import T_BASELINK_BASE
+from ur3hanoi.robot.urdf import JOINT_NAMES
 from ur3hanoi.sim.model import SCENE_XML, T_ee_tcp, cup_geometry, quat_wxyz
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import block_center_world, table_z
@@ -220,6 +221,15 @@ class TaskScene:
     def arm_q(self) -> FloatArray:
         """The six arm joint angles [rad]."""
         return self.data.qpos[self.arm_qadr].copy()
+
+    def place_block(self, block: int, xyz: FloatArray) -> None:
+        """Put ``block`` with its centre at ``xyz`` [m, world], upright and at rest (by hand: run
+        :func:`mujoco.mj_forward` before reading positions)."""
+        adr = self.block_qadr[block]
+        self.data.qpos[adr:adr + 3] = xyz
+        self.data.qpos[adr + 3:adr + 7] = (1.0, 0.0, 0.0, 0.0)
+        dof = int(self.model.jnt_dofadr[self.model.body_jntadr[self.block_body[block]]])
+        self.data.qvel[dof:dof + 6] = 0.0
 
 
 def build_task_scene(station: Station, start: int, n_blocks: int, removed: int | None = None,

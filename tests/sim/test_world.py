@@ -1,20 +1,21 @@
-"""The simulated station stepped in world time (no ROS): settling for the lab's wait, suction, blocks, faults."""
+"""ur3hanoi.sim.world: the movej world stepped in world time (no ROS): settling for the lab's wait, suction, blocks,
+faults."""
 
 from __future__ import annotations
 
 import pytest
 
-from ur3hanoi.interface.command import MoveCommand
-from ur3hanoi.interface.errors import RosError
-from ur3hanoi.interface.world import StationWorld, WorldConfig
+from ur3hanoi.errors import SimulationError
+from ur3hanoi.sim.config import SimConfig
+from ur3hanoi.sim.world import MoveJWorld
 from ur3hanoi.tables.ik_table import generate_table
 
 TOL = 5e-4  # [rad] the lab's move_arm tolerance
 
 
-def go(world: StationWorld, q, io_0: bool = False, v: float = 4.0, a: float = 4.0, rest_s: float = 0.3):
+def go(world: MoveJWorld, q, io_0: bool = False, v: float = 4.0, a: float = 4.0, rest_s: float = 0.3):
     """Run one movej and rest_s [s] after it; returns (settle time after the profile [s], error after rest [rad])."""
-    world.begin(MoveCommand(tuple(float(x) for x in q), v, a, io_0))
+    world.begin(q, v, a, io_0)
     while world.moving:
         world.step()
     t_end, settle = world.time, None
@@ -31,7 +32,7 @@ def go(world: StationWorld, q, io_0: bool = False, v: float = 4.0, a: float = 4.
 @pytest.mark.parametrize("name", ["lab_sim", "lab_real"])
 def test_every_table_pose_settles_within_the_labs_tolerance(name, request):
     station = request.getfixturevalue(name)
-    world = StationWorld(station, 0, station.n_heights)
+    world = MoveJWorld(station, 0, station.n_heights)
     Q = generate_table(station).q
     worst_settle, worst_err = 0.0, 0.0
     for t in range(station.n_towers):
@@ -45,7 +46,7 @@ def test_every_table_pose_settles_within_the_labs_tolerance(name, request):
 
 
 def test_suction_grasps_holds_and_releases_with_the_courses_voltages(lab_sim):
-    world = StationWorld(lab_sim, 0, 3)
+    world = MoveJWorld(lab_sim, 0, 3)
     Q = generate_table(lab_sim).q
     assert world.feedback().digin == 0 and world.feedback().ain0 == pytest.approx(1.05, abs=0.05)
     go(world, Q[0, 2, 1])
@@ -68,7 +69,7 @@ def test_suction_grasps_holds_and_releases_with_the_courses_voltages(lab_sim):
 
 
 def test_spawn_and_remove_blocks(lab_sim, lab_real):
-    world = StationWorld(lab_sim, 0, 3, removed=1)
+    world = MoveJWorld(lab_sim, 0, 3, removed=1)
     assert {b.block: (b.tower, b.height) for b in world.blocks()} == {0: (0, 0), 1: (None, None), 2: (0, 2)}
     world.spawn(1)
     assert {b.block: (b.tower, b.height) for b in world.blocks()} == {0: (1, 0), 1: (1, 1), 2: (1, 2)}
@@ -80,16 +81,16 @@ def test_spawn_and_remove_blocks(lab_sim, lab_real):
     assert {b.block: (b.tower, b.height) for b in world.blocks()} == {0: (None, None), 1: (1, 1), 2: (1, 2)}
     assert [e.as_dict()["kind"] for e in world.events][-2:] == ["spawn", "removed"]
     # Stacked: blocks above a removed one rest a level lower, like ur3hanoi solve's spawn.
-    stacked = StationWorld(lab_real, 2, 3, removed=0)
+    stacked = MoveJWorld(lab_real, 2, 3, removed=0)
     assert {b.block: (b.tower, b.height) for b in stacked.blocks()} == {0: (None, None), 1: (2, 0), 2: (2, 1)}
-    with pytest.raises(RosError, match=r"tower 4 is invalid: expected 1\.\.3"):
+    with pytest.raises(SimulationError, match=r"tower 4 is invalid: expected 1\.\.3"):
         world.spawn(3)
-    with pytest.raises(RosError, match=r"block 4 is invalid: expected 1\.\.3"):
+    with pytest.raises(SimulationError, match=r"block 4 is invalid: expected 1\.\.3"):
         world.remove(3)
 
 
 def test_removing_the_held_block_drops_it(lab_sim):
-    world = StationWorld(lab_sim, 0, 3)
+    world = MoveJWorld(lab_sim, 0, 3)
     Q = generate_table(lab_sim).q
     go(world, Q[0, 2, 0])
     go(world, Q[0, 2, 0], io_0=True)
@@ -100,12 +101,12 @@ def test_removing_the_held_block_drops_it(lab_sim):
 
 
 def test_drop_on_grasp_loses_the_block_early_in_the_next_motion(lab_sim):
-    world = StationWorld(lab_sim, 0, 3, config=WorldConfig(drop_delay_s=0.2), drop_on_grasp=1)
+    world = MoveJWorld(lab_sim, 0, 3, config=SimConfig(drop_delay_s=0.2), drop_on_grasp=1)
     Q = generate_table(lab_sim).q
     for grasp, (t, h) in enumerate([(0, 2), (0, 1)]):
         go(world, Q[t, h, 0], io_0=False)
         go(world, Q[t, h, 0], io_0=True)
-        world.begin(MoveCommand(tuple(Q[t, h, 1]), 4.0, 4.0, True))
+        world.begin(Q[t, h, 1], 4.0, 4.0, True)
         held = []
         while world.moving:
             world.step()
@@ -120,5 +121,5 @@ def test_drop_on_grasp_loses_the_block_early_in_the_next_motion(lab_sim):
 
 
 def test_period_must_be_a_multiple_of_the_physics_step(lab_sim):
-    with pytest.raises(RosError, match=r"control period 0\.003 s is invalid"):
-        StationWorld(lab_sim, 0, 3, config=WorldConfig(period_s=0.003))
+    with pytest.raises(SimulationError, match=r"control period 0\.003 s is invalid"):
+        MoveJWorld(lab_sim, 0, 3, config=SimConfig(period_s=0.003))

@@ -1,12 +1,13 @@
-"""The station's physical side: the MuJoCo task scene of a calibration driven like the UR controller drives the arm.
+"""The simulator's side of a ROS server: the MuJoCo task scene of a calibration driven like the UR controller
+drives the arm, one ``movej`` command after another.
 
-:class:`StationWorld` owns the scene (:func:`ur3hanoi.sim.build_task_scene`), the suction cup
-(:class:`ur3hanoi.sim.SuctionCup`: grasp by weld, ``gripper_input`` feedback) and the blocks. Each :meth:`step`
-advances one control period: the reference of the running ``movej`` (:mod:`ur3hanoi.robot.movej`) is sent to the
-position servos with velocity feed-forward (as :func:`ur3hanoi.sim.run_plan` does), the physics runs, the suction
-grasps a block in reach. Nothing here knows ROS or the wall clock: the node (:mod:`ur3hanoi.interface.ros1.server`)
-calls
-:meth:`step` once per period in real time, tests call it as fast as they like.
+:class:`MoveJWorld` owns the scene (:func:`ur3hanoi.sim.build_task_scene`), the suction cup
+(:class:`ur3hanoi.sim.SuctionCup`: grasp by weld, ``gripper_input`` feedback) and the blocks. Each
+:meth:`~MoveJWorld.step` advances one control period: the reference of the running ``movej``
+(:mod:`ur3hanoi.robot.movej`) goes through the servo law ``solve`` uses too (:class:`~ur3hanoi.sim.servo.JointServo`:
+interpolation, velocity and acceleration feed-forward), the physics runs, the suction grasps a block in reach.
+Nothing here knows ROS or the wall clock: the server (:mod:`ur3hanoi.interface.server`) calls
+:meth:`~MoveJWorld.step` once per period in real time, tests call it as fast as they like.
 
 Blocks are numbered from 0 here (0 = bottom/green); the ROS topics and the report number them from 1. Removed
 blocks are parked on the floor beside the table ("off-grid"), so a respawn brings them back.
@@ -15,60 +16,28 @@ blocks are parked on the floor beside the table ("off-grid"), so a respawn bring
 from __future__ import annotations
 
 from collections import Counter, deque
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import mujoco
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
+from ur3hanoi.errors import SimulationError
 from ur3hanoi.hanoi import block_colour
-from ur3hanoi.interface.command import MoveCommand
-from ur3hanoi.interface.errors import RosError
-from ur3hanoi.robot.model import JOINT_NAMES
-from ur3hanoi.robot.movej import MoveJ, plan_movej
-from ur3hanoi.sim import (
-    FinalBlock,
-    GripperInput,
-    SceneConfig,
-    SuctionConfig,
-    SuctionCup,
-    build_task_scene,
-    slot_centers,
-    slot_of,
-    start_slots,
-)
+from ur3hanoi.robot.movej import MoveJ, MoveJReference
+from ur3hanoi.sim.config import SimConfig
+from ur3hanoi.sim.result import FinalBlock
+from ur3hanoi.sim.scene import build_task_scene, slot_centers, start_slots
+from ur3hanoi.sim.servo import JointServo
+from ur3hanoi.sim.suction import GripperInput, SuctionCup
+from ur3hanoi.sim.verify import at_home, locate_blocks
 from ur3hanoi.station.calibration import Station
 
 EVENTS_KEPT = 200
 """How many of the latest suction and block events the world keeps (a flood of commands toggling the suction must
-not grow memory); :attr:`StationWorld.event_counts` counts every event."""
-
-
-@dataclass(frozen=True)
-class WorldConfig:
-    """Settings of the simulated station.
-
-    Attributes:
-        period_s: control period [s]; a multiple of the physics step. 8 ms: the CB3 controller's 125 Hz (the
-            course driver publishes ``ur3/position`` every 8 ms).
-        settle_tolerance_rad: the arm is "at" its destination when every joint is within this angle [rad] (the
-            lab's ``move_arm`` waits for 0.0005 rad).
-        scene, suction: see :class:`ur3hanoi.sim.SceneConfig`, :class:`ur3hanoi.sim.SuctionConfig`.
-        seed: seeds the ``AIN0`` noise.
-        place_tolerance_m: a block is in a slot when its centre is within this distance [m] of the slot's centre.
-        home_tolerance_rad: "at home" when every joint is within this angle [rad] of the home pose.
-        drop_delay_s: with a drop injected on a grasp, the block falls this long [s] into the next motion.
-    """
-
-    period_s: float = 0.008
-    settle_tolerance_rad: float = 5e-4
-    scene: SceneConfig = field(default_factory=SceneConfig)
-    suction: SuctionConfig = field(default_factory=SuctionConfig)
-    seed: int = 0
-    place_tolerance_m: float = 0.005
-    home_tolerance_rad: float = 0.01
-    drop_delay_s: float = 0.2
+not grow memory); :attr:`MoveJWorld.event_counts` counts every event."""
 
 
 @dataclass(frozen=True)
@@ -91,8 +60,8 @@ class WorldEvent:
         return out
 
 
-class StationWorld:
-    """The simulated UR3 station (see the module docstring).
+class MoveJWorld:
+    """The simulated arm, suction and blocks of a station, driven by ``movej`` commands (see the module docstring).
 
     Args:
         station: the calibration.
@@ -105,24 +74,17 @@ class StationWorld:
     """
 
     def __init__(self, station: Station, start: int, n_blocks: int, removed: int | None = None,
-                 config: WorldConfig | None = None, drop_on_grasp: int | None = None) -> None:
-        self.config = cfg = config if config is not None else WorldConfig()
+                 config: SimConfig | None = None, drop_on_grasp: int | None = None) -> None:
+        self.config = cfg = config if config is not None else SimConfig()
         self.station = station
         if not 0 <= start < station.n_towers:
-            raise RosError(f"start tower {start + 1} is invalid: expected 1..{station.n_towers}")
+            raise SimulationError(f"start tower {start + 1} is invalid: expected 1..{station.n_towers}")
         if removed is not None and not 0 <= removed < n_blocks:
-            raise RosError(f"removed block height {removed + 1} is invalid: expected 1..{n_blocks}")
+            raise SimulationError(f"removed block height {removed + 1} is invalid: expected 1..{n_blocks}")
         self.scene = build_task_scene(station, start, n_blocks, None, cfg.scene)
         m = self.scene.model
-        self.nsub = round(cfg.period_s / m.opt.timestep)
-        if self.nsub < 1 or abs(self.nsub * m.opt.timestep - cfg.period_s) > 1e-9:
-            raise RosError(f"control period {cfg.period_s} s is invalid: expected a multiple of the physics step "
-                           f"{m.opt.timestep} s")
+        self.servo = JointServo(self.scene, cfg.period_s, cfg.accel_feedforward)
         self.n_blocks = n_blocks
-        self._act = np.array([m.actuator(j.removesuffix("_joint")).id for j in JOINT_NAMES])
-        kp = m.actuator_gainprm[self._act, 0]
-        kv = -m.actuator_biasprm[self._act, 2]
-        self._ff = kv / kp  # velocity feed-forward [s]: servo force kp (q_ref - q) + kv (qd_ref - qd)
         self.cup = SuctionCup(self.scene, cfg.suction, seed=cfg.seed)
         self.events: deque[WorldEvent] = deque(maxlen=EVENTS_KEPT)  # the last ones; counts of all below
         self.event_counts: Counter[str] = Counter()
@@ -134,11 +96,8 @@ class StationWorld:
         # Parking spots on the floor, 1 m beside the robot, away from the table (which spans the grid +- 0.15 m).
         self._park = {b: np.array([base[0] - 1.0, base[1] - 1.0 - 0.1 * b, floor_z + 0.5 * s]) for b in range(n_blocks)}
         self.removed: set[int] = set()
-        self.reference: FloatArray = station.q_home_array.copy()  # the servo reference at the end of the last step
-        self.target: FloatArray = self.reference.copy()  # destination of the current (or last) move
-        self.motion: MoveJ | None = None
-        self._t_motion = 0.0  # time into the current motion [s]
-        self._servo_prev = self.reference.copy()
+        self.reference = MoveJReference(station.q_home_array, station.limits.v_max, station.limits.a_max)
+        self.servo.reset(self.reference.q)
         self._grasps = 0
         self._drop_on_grasp = drop_on_grasp
         self._drop_armed = False
@@ -157,9 +116,14 @@ class StationWorld:
         return self.scene.arm_q()
 
     @property
+    def target(self) -> FloatArray:
+        """Destination of the current (or last) move [rad]."""
+        return self.reference.target
+
+    @property
     def moving(self) -> bool:
         """True while a ``movej`` profile runs."""
-        return self.motion is not None
+        return self.reference.motion is not None
 
     def error_to_target(self) -> float:
         """Largest joint distance [rad] between the measured angles and the current destination."""
@@ -168,7 +132,7 @@ class StationWorld:
     @property
     def settled(self) -> bool:
         """No profile running and every joint within ``settle_tolerance_rad`` of the destination."""
-        return self.motion is None and self.error_to_target() <= self.config.settle_tolerance_rad
+        return not self.moving and self.error_to_target() <= self.config.settle_tolerance_rad
 
     @property
     def suction_on(self) -> bool:
@@ -188,19 +152,12 @@ class StationWorld:
         self.event_counts[event.kind] += 1
 
     # ------------------------------------------------------------------------------------------------ motion
-    def begin(self, command: MoveCommand) -> MoveJ:
-        """Switch the suction to ``command.io_0`` and start its ``movej`` from the current reference."""
-        if command.io_0 != self.cup.on:
-            self._suction(command.io_0)
-        lim = self.station.limits
-        self.motion = plan_movej(self.reference, command.destination, command.v, command.a, lim.v_max, lim.a_max)
-        self.target = self.motion.q1.copy()
-        self._t_motion = 0.0
-        motion = self.motion
-        if motion.duration <= 0.0:
-            self.motion = None
-            self.reference = motion.q1.copy()
-        return motion
+    def begin(self, destination: Sequence[float], v: float, a: float, suction: bool) -> MoveJ:
+        """Switch the suction on or off and start ``movej(destination, a, v)`` (destination [rad], ``v`` [rad/s],
+        ``a`` [rad/s^2], capped at the station's limits) from the current reference."""
+        if suction != self.cup.on:
+            self._suction(suction)
+        return self.reference.begin(destination, v, a)
 
     def _suction(self, on: bool) -> None:
         held = self.cup.attached
@@ -213,20 +170,9 @@ class StationWorld:
         self._attached = self.cup.attached
 
     def step(self) -> None:
-        """Advance one control period: servo reference, physics, suction grasp, injected drop."""
-        d, m = self.scene.data, self.scene.model
-        if self.motion is not None:
-            self._t_motion += self.config.period_s
-            q_ref, qd_ref = self.motion.sample(self._t_motion)
-            if self._t_motion >= self.motion.duration:
-                self.motion = None
-        else:
-            q_ref, qd_ref = self.reference, np.zeros_like(self.reference)
-        self.reference = q_ref
-        servo = q_ref + self._ff * qd_ref
-        # The mean of the (linear) servo command over the period: holding the end value would lead by a period.
-        d.ctrl[self._act] = 0.5 * (self._servo_prev + servo)
-        self._servo_prev = servo
+        """Advance one control period: suction grasp, injected drop, then the servo to the next reference sample
+        (physics)."""
+        sample = self.reference.advance(self.config.period_s)
         self.cup.update()
         if self.cup.attached is not None and self._attached is None:
             self._event(WorldEvent(self.time, "grasp", self.cup.attached))
@@ -234,38 +180,33 @@ class StationWorld:
                 self._drop_armed = True
             self._grasps += 1
         self._attached = self.cup.attached
-        if self._drop_armed and self.motion is not None and self._t_motion >= self.config.drop_delay_s:
+        if self._drop_armed and self.moving and self.reference.t >= self.config.drop_delay_s:
             self._drop_armed = False
             lost = self.cup.lose_block()
             self.cup.grasp_enabled = False  # a cup that lost its seal does not catch the falling block again
             self._attached = None
             if lost is not None:
                 self._event(WorldEvent(self.time, "dropped", lost))
-        mujoco.mj_step(m, d, nstep=self.nsub)
+        if sample is None:
+            self.servo.hold(self.reference.q)
+        else:
+            self.servo.track(*sample)
 
     # ------------------------------------------------------------------------------------------------ blocks
-    def _set_block(self, block: int, xyz: FloatArray) -> None:
-        d = self.scene.data
-        adr = self.scene.block_qadr[block]
-        d.qpos[adr:adr + 3] = xyz
-        d.qpos[adr + 3:adr + 7] = (1.0, 0.0, 0.0, 0.0)
-        dof = int(self.scene.model.jnt_dofadr[self.scene.model.body_jntadr[self.scene.block_body[block]]])
-        d.qvel[dof:dof + 6] = 0.0
-
     def spawn(self, tower: int, removed: int | None = None) -> None:
         """Put every block on ``tower`` (0-based) like ``lab2_spawn.py``, leaving height ``removed`` empty.
 
         The suction lets go of any block first; a removed block is parked off-grid.
         """
         if not 0 <= tower < self.station.n_towers:
-            raise RosError(f"tower {tower + 1} is invalid: expected 1..{self.station.n_towers}")
+            raise SimulationError(f"tower {tower + 1} is invalid: expected 1..{self.station.n_towers}")
         if self.cup.attached is not None:
             self.cup.lose_block()
             self._attached = None
         slots = start_slots(self.station, tower, self.n_blocks, removed)
         self.removed = set(range(self.n_blocks)) - set(slots)
         for b in range(self.n_blocks):
-            self._set_block(b, self._centers[slots[b]] if b in slots else self._park[b])
+            self.scene.place_block(b, self._centers[slots[b]] if b in slots else self._park[b])
         mujoco.mj_forward(self.scene.model, self.scene.data)
         self._event(WorldEvent(self.time, "spawn", tower=tower))
         for b in sorted(self.removed):
@@ -277,7 +218,7 @@ class StationWorld:
         Returns ``"removed"``, ``"dropped"`` (it was held) or ``"absent"`` (already removed).
         """
         if not 0 <= block < self.n_blocks:
-            raise RosError(f"block {block + 1} is invalid: expected 1..{self.n_blocks}")
+            raise SimulationError(f"block {block + 1} is invalid: expected 1..{self.n_blocks}")
         if block in self.removed:
             return "absent"
         kind = "removed"
@@ -286,21 +227,15 @@ class StationWorld:
             self._attached = None
             kind = "dropped"
         self.removed.add(block)
-        self._set_block(block, self._park[block])
+        self.scene.place_block(block, self._park[block])
         mujoco.mj_forward(self.scene.model, self.scene.data)
         self._event(WorldEvent(self.time, kind, block))
         return kind
 
     def blocks(self) -> tuple[FinalBlock, ...]:
         """Where every block is now: tower/height (0-based) of the slot within ``place_tolerance_m``, else None."""
-        out = []
-        tol = self.config.place_tolerance_m
-        for b in range(self.n_blocks):
-            xyz = self.scene.block_pos(b)
-            slot = slot_of(self._centers, xyz, tol)
-            out.append(FinalBlock(b, None if slot is None else slot[0], None if slot is None else slot[1],
-                                  (float(xyz[0]), float(xyz[1]), float(xyz[2]))))
-        return tuple(out)
+        return locate_blocks(self.scene, self._centers, self.config.place_tolerance_m)
 
     def at_home(self) -> bool:
-        return bool(np.max(np.abs(self.q - self.station.q_home_array)) <= self.config.home_tolerance_rad)
+        """Every joint within ``home_tolerance_rad`` of the home pose."""
+        return at_home(self.scene, self.config.home_tolerance_rad)
