@@ -116,8 +116,10 @@ class OutputError(Ur3HanoiError):
 
 
 class DriverError(Ur3HanoiError):
-    """The arm's driver stopped publishing its position, or publishes what no UR driver does (not six finite joint
-    angles): a teach session cannot go on (what was recorded is saved)."""
+    """The arm's driver (the course's, or ur3hanoi's server) cannot be reached, stopped publishing, did not reach a
+    commanded pose in time, or publishes what no UR driver does (not six finite joint angles). A solve stops (exit
+    2); a teach session stops with what was recorded saved. Each binding's middleware failures are subclasses
+    (``ur3hanoi.interface.ros1.errors.RosError``, ``ur3hanoi.interface.ros2.errors.DdsError``)."""
 
 
 class IKError(Ur3HanoiError):

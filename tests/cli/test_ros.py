@@ -76,11 +76,11 @@ def test_station_outputs_are_refused_before_the_station_starts(command, option, 
                                                               monkeypatch, capsys):
     """Both stations check --video, --frames and --report the same way (ur3hanoi.io.atomic), in one line, before
     anything runs (no master, no DDS participant, no rendering process) and without creating a file."""
-    from ur3hanoi.interface.ros1.server import RosStation
-    from ur3hanoi.interface.ros2.server import Ros2Station
+    from ur3hanoi.interface.ros1.server import RosServer
+    from ur3hanoi.interface.ros2.server import Ros2Server
 
     started: list[str] = []
-    for cls in (RosStation, Ros2Station):
+    for cls in (RosServer, Ros2Server):
         monkeypatch.setattr(cls, "run", lambda self: started.append(type(self).__name__) or {})
     target = target.format(tmp=tmp_path)
     assert main([command, "--duration", "0.5", option, target]) == 2

@@ -8,15 +8,15 @@ import math
 import numpy as np
 import pytest
 
-from ur3hanoi.interface.controller import StationDriver
+from ur3hanoi.interface.controller import Controller
 from ur3hanoi.interface.errors import CommandError
 from ur3hanoi.sim.world import MoveJWorld
 from ur3hanoi.tables.ik_table import generate_table
 
 
 @pytest.fixture
-def driver(lab_sim) -> StationDriver:
-    return StationDriver(MoveJWorld(lab_sim, 0, 3), max_queue=3)
+def driver(lab_sim) -> Controller:
+    return Controller(MoveJWorld(lab_sim, 0, 3), max_queue=3)
 
 
 def test_refused_commands_do_not_move_the_arm(driver, lab_sim):
@@ -93,7 +93,7 @@ def test_the_cap_allows_the_slowest_course_speed_and_huge_finite_values(driver, 
 
 def test_records_are_bounded_and_totals_count_every_command(lab_sim):
     """A flood of commands: the kept records and the summary's size do not grow with the number of commands."""
-    driver = StationDriver(MoveJWorld(lab_sim, 0, 3), max_queue=5, records_kept=10)
+    driver = Controller(MoveJWorld(lab_sim, 0, 3), max_queue=5, records_kept=10)
     home = list(lab_sim.q_home_array)
     near = [home[0] + 0.01, *home[1:]]
     sent = 0

@@ -11,16 +11,16 @@ import pytest
 
 from tests.support.ros_support import final_slots, free_port, requires_ros, ros_env, roscore, run, station, ur3hanoi_cmd
 from ur3hanoi.errors import PuzzleError, SuctionFaultError
-from ur3hanoi.interface.controller import StationDriver
+from ur3hanoi.interface.controller import Controller
 from ur3hanoi.interface.solve import run_lab_solve
 from ur3hanoi.sim.world import MoveJWorld
 from ur3hanoi.tables.ik_table import generate_table
 
 
 class SimArm:
-    """The solver's Arm over StationDriver in world time: what RosArm does over ROS, without the wall clock."""
+    """The solver's Arm over Controller in world time: what RosArm does over ROS, without the wall clock."""
 
-    def __init__(self, driver: StationDriver, v: float = 4.0, a: float = 4.0) -> None:
+    def __init__(self, driver: Controller, v: float = 4.0, a: float = 4.0) -> None:
         self.driver, self.v, self.a = driver, v, a
         self.world = driver.world
         self.io = False
@@ -79,7 +79,7 @@ def slots(world: MoveJWorld) -> dict[int, tuple[int | None, int | None]]:
 def test_solves_in_world_time(name, start, end, request):
     station = request.getfixturevalue(name)
     world = MoveJWorld(station, start, 3)
-    driver = StationDriver(world)
+    driver = Controller(world)
     arm = SimArm(driver)
     result = run_lab_solve(arm, generate_table(station).q, station.q_home_array, start, end, 3)
     assert len(result.moves) == 7
@@ -91,7 +91,7 @@ def test_solves_in_world_time(name, start, end, request):
 
 def test_missing_block_halts_suction_off_at_home(lab_sim):
     world = MoveJWorld(lab_sim, 0, 3, removed=1)
-    arm = SimArm(StationDriver(world))
+    arm = SimArm(Controller(world))
     with pytest.raises(SuctionFaultError) as err:
         run_lab_solve(arm, generate_table(lab_sim).q, lab_sim.q_home_array, 0, 2, 3)
     assert err.value.exit_code == 3
@@ -105,7 +105,7 @@ def test_missing_block_halts_suction_off_at_home(lab_sim):
 
 def test_block_dropped_during_the_carry_halts(lab_sim):
     world = MoveJWorld(lab_sim, 0, 3, drop_on_grasp=2)  # the third grasp: red, tower 3 -> tower 2
-    arm = SimArm(StationDriver(world))
+    arm = SimArm(Controller(world))
     with pytest.raises(SuctionFaultError, match="suction fault in move 3/7: red block 3 was dropped while carrying "
                                                 "it from tower 3 to tower 2"):
         run_lab_solve(arm, generate_table(lab_sim).q, lab_sim.q_home_array, 0, 2, 3)
@@ -116,7 +116,7 @@ def test_block_dropped_during_the_carry_halts(lab_sim):
 @pytest.mark.parametrize(("leg", "what"), [(1, "lift"), (2, "carry"), (3, "descent")])
 def test_block_lost_in_any_leg_with_a_block_halts(lab_sim, leg, what):
     world = MoveJWorld(lab_sim, 0, 3)
-    arm = SimArm(StationDriver(world))
+    arm = SimArm(Controller(world))
     arm.drop_on_watched_move = 3 + leg  # move 2 (its watched moves are 4, 5, 6)
     with pytest.raises(SuctionFaultError, match="suction fault in move 2/7: yellow block 2 was dropped while "
                                                 "carrying it from tower 1 to tower 2"):
@@ -125,7 +125,7 @@ def test_block_lost_in_any_leg_with_a_block_halts(lab_sim, leg, what):
 
 
 def test_bad_table_shape_is_refused(lab_sim):
-    arm = SimArm(StationDriver(MoveJWorld(lab_sim, 0, 3)))
+    arm = SimArm(Controller(MoveJWorld(lab_sim, 0, 3)))
     with pytest.raises(PuzzleError, match=r"table shape \(3, 3, 6\) is invalid"):
         run_lab_solve(arm, np.zeros((3, 3, 6)), lab_sim.q_home_array, 0, 2, 3)
 

@@ -93,7 +93,7 @@ def check_station_outputs(args: argparse.Namespace, default_calibration: str) ->
 
 
 def station_options(args: argparse.Namespace, default_calibration: str, report: Path | None) -> dict[str, Any]:
-    """The :class:`ur3hanoi.interface.server.CoreOptions` fields of the common options (numbers from 0)."""
+    """The :class:`ur3hanoi.interface.server.ServerOptions` fields of the common options (numbers from 0)."""
     return {"calibration": args.calibration or default_calibration, "start": args.start - 1,
             "n_blocks": args.blocks, "removed": None if args.remove_block is None else args.remove_block - 1,
             "drop_on_grasp": None if args.drop_on_grasp is None else args.drop_on_grasp - 1, "seed": args.seed,

@@ -65,11 +65,11 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
 
 def _run_station(args: argparse.Namespace) -> int:
     report_file = remote.check_station_outputs(args, DEFAULT_CALIBRATION)  # before any work
-    from ur3hanoi.interface.ros1.server import RosStation, StationOptions
+    from ur3hanoi.interface.ros1.server import RosServer, RosServerOptions
 
-    options = StationOptions(**remote.station_options(args, DEFAULT_CALIBRATION, report_file),
+    options = RosServerOptions(**remote.station_options(args, DEFAULT_CALIBRATION, report_file),
                              master_uri=args.master, host=args.host)
-    node = RosStation(options)
+    node = RosServer(options)
     # Standard output carries only the JSON report: whatever else writes to file descriptor 1 (rospy's info
     # handler, C libraries) goes to stderr while the node runs.
     sys.stdout.flush()

@@ -74,12 +74,12 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
 
 def _run_station(args: argparse.Namespace) -> int:
     report_file = remote.check_station_outputs(args, DEFAULT_ROS2_CALIBRATION)  # before any work
-    from ur3hanoi.interface.ros2.server import Ros2Station, Ros2StationOptions
+    from ur3hanoi.interface.ros2.server import Ros2Server, Ros2ServerOptions
 
-    options = Ros2StationOptions(**remote.station_options(args, DEFAULT_ROS2_CALIBRATION, report_file),
+    options = Ros2ServerOptions(**remote.station_options(args, DEFAULT_ROS2_CALIBRATION, report_file),
                                  timing=args.timing, convention=args.convention, network=args.network,
                                  domain_id=args.domain_id)
-    report = Ros2Station(options).run()
+    report = Ros2Server(options).run()
     if report_file is not None:
         print(remote.stopped_line("ros2-station", report, f"report {args.report}"), flush=True)
     return 0
@@ -96,7 +96,7 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_solve(args: argparse.Namespace) -> int:
-    from ur3hanoi.interface.errors import RosError
+    from ur3hanoi.errors import InputError
     from ur3hanoi.interface.ros2.client import Ros2Arm, Ros2ArmConfig
     from ur3hanoi.interface.ros2.dds import domain_id_from_env
 
@@ -104,7 +104,7 @@ def _run_solve(args: argparse.Namespace) -> int:
     try:
         domain = domain_id_from_env() if args.domain_id is None else args.domain_id
     except ValueError as exc:
-        raise RosError(str(exc)) from None
+        raise InputError(str(exc)) from None
     arm = Ros2Arm(Ros2ArmConfig(v=args.v, a=args.a, convention=args.convention), domain, args.network,
                   log=remote.say_for(args))
     outcome: dict[str, object] = {"start": job.start + 1, "end": job.end + 1, "blocks": job.n_blocks,

@@ -87,7 +87,7 @@ def _names(args: argparse.Namespace, where: str = "") -> DriverNames:
 
 
 def _connect(args: argparse.Namespace) -> tuple[Any, DriverNames]:
-    """The connected arm of ``--via`` and how messages name it (RosError: no driver within ``--wait``)."""
+    """The connected arm of ``--via`` and how messages name it (DriverError: no driver within ``--wait``)."""
     print(f"ur3hanoi teach: looking for the driver (at most {args.wait:g} s) ...", flush=True)
     if args.via == "ros":
         from ur3hanoi.interface.ros1.client import ArmConfig, RosArm
@@ -95,14 +95,14 @@ def _connect(args: argparse.Namespace) -> tuple[Any, DriverNames]:
         arm: Any = RosArm(ArmConfig(connect_timeout_s=args.wait), master_uri=args.master)
         where = arm.master_uri
     else:
-        from ur3hanoi.interface.errors import RosError
+        from ur3hanoi.errors import InputError
         from ur3hanoi.interface.ros2.client import Ros2Arm, Ros2ArmConfig
         from ur3hanoi.interface.ros2.dds import domain_id_from_env
 
         try:
             domain = domain_id_from_env() if args.domain_id is None else args.domain_id
         except ValueError as exc:
-            raise RosError(str(exc)) from None
+            raise InputError(str(exc)) from None
         arm = Ros2Arm(Ros2ArmConfig(connect_timeout_s=args.wait, convention=args.convention), domain, args.network)
         where = f"ROS_DOMAIN_ID {domain} ({args.network})"
     try:

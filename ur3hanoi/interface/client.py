@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.interface.errors import RosError
+from ur3hanoi.errors import DriverError
 
 HISTORY_S = 2.0
 """[s] how long the arm keeps the positions that arrived (:meth:`TopicArm.samples`)."""
@@ -138,20 +138,20 @@ class TopicArm:
         destination.
 
         Raises:
-            RosError: naming what did not appear within ``connect_timeout_s`` on ``where`` and the ``driver``
+            DriverError: naming what did not appear within ``connect_timeout_s`` on ``where`` and the ``driver``
                 that should be running.
         """
         ok = self.wait_until(lambda: bool(self.malformed) or (self._q is not None and self._digin is not None
                                                                 and self._subscribed()),
                              self.config.connect_timeout_s)
         if self.malformed and self._q is None:
-            raise RosError(f"the driver on {where} publishes {self.malformed} on {self.topics.position}: is it a UR "
+            raise DriverError(f"the driver on {where} publishes {self.malformed} on {self.topics.position}: is it a UR "
                            f"driver ({driver})?")
         if not ok:
             t = self.topics
             missing = [name for name, seen in ((t.position, self._q is not None), (t.gripper, self._digin is not None),
                                                (f"a {t.command} subscriber", self._subscribed())) if not seen]
-            raise RosError(f"no {', '.join(missing)} within {self.config.connect_timeout_s:g} s on {where}: is "
+            raise DriverError(f"no {', '.join(missing)} within {self.config.connect_timeout_s:g} s on {where}: is "
                            f"{driver} running?")
         self._destination = self.q
 
@@ -161,7 +161,7 @@ class TopicArm:
         """The last position [rad, controller convention]."""
         self._poll()
         if self._q is None:
-            raise RosError(f"no {self.topics.position} received yet: call connect() first")
+            raise DriverError(f"no {self.topics.position} received yet: call connect() first")
         return self._q.copy()
 
     def held(self) -> bool:
@@ -202,7 +202,7 @@ class TopicArm:
         """Command ``q`` [rad] (with the current suction state) and wait until every joint is within tolerance.
 
         Raises:
-            RosError: not reached within ``move_timeout_s`` (re-published every ``republish_s``), or no position
+            DriverError: not reached within ``move_timeout_s`` (re-published every ``republish_s``), or no position
                 message for ``position_timeout_s``.
         """
         cfg = self.config
@@ -220,11 +220,11 @@ class TopicArm:
             now = time.monotonic()
             silent = now - max(self._t_position, t0)
             if silent > cfg.position_timeout_s:
-                raise RosError(f"position updates stopped: no message on /{self.topics.position} for {silent:.1f} s "
+                raise DriverError(f"position updates stopped: no message on /{self.topics.position} for {silent:.1f} s "
                                "(the driver publishes it every cycle); is the driver still running?")
             if now - t0 > cfg.move_timeout_s:
                 err = float(np.max(np.abs(self.q - goal)))
-                raise RosError(f"the arm did not reach {np.round(goal, 4).tolist()} within {cfg.move_timeout_s:g} s "
+                raise DriverError(f"the arm did not reach {np.round(goal, 4).tolist()} within {cfg.move_timeout_s:g} s "
                                f"(still {err:.4f} rad away): expected every joint within {cfg.tolerance_rad} rad")
             if now - last >= cfg.republish_s:
                 self._republish(msg)

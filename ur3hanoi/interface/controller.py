@@ -1,6 +1,6 @@
 """The station's controller logic: accept or refuse commands, execute them in order, measure how the arm settles.
 
-:class:`StationDriver` sits between the ROS callbacks and :class:`~ur3hanoi.sim.world.MoveJWorld`. Accepted
+:class:`Controller` sits between the ROS callbacks and :class:`~ur3hanoi.sim.world.MoveJWorld`. Accepted
 commands wait in a FIFO and each starts when the previous motion's profile has ended (a controller's motion
 queue); the lab's ``move_arm`` re-publishes its command every 5 s while waiting, which then costs a zero-length
 move, never a jump. Every executed command is recorded with its duration, the time the arm needed to come within
@@ -74,7 +74,7 @@ class Rejection:
         return {"t": round(self.t, 4), "reason": self.reason}
 
 
-class StationDriver:
+class Controller:
     """Command FIFO and records over a :class:`~ur3hanoi.sim.world.MoveJWorld` (see the module docstring).
 
     Args:

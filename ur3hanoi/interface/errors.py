@@ -1,8 +1,9 @@
-"""Errors of a remote station and its clients, whatever the middleware. All derive from
-:class:`ur3hanoi.errors.Ur3HanoiError` (one line, exit code 2).
+"""Errors of a server (:mod:`ur3hanoi.interface.server`), whatever the middleware.
 
-A suction fault seen through the gripper feedback is the project's :class:`ur3hanoi.errors.SuctionFaultError`
-(exit code 3), as in ``ur3hanoi solve``.
+A client's errors are :class:`ur3hanoi.errors.DriverError` (the driver cannot be reached, stopped, answers
+wrongly) and its middleware's subclasses (:class:`ur3hanoi.interface.ros1.errors.RosError`,
+:class:`ur3hanoi.interface.ros2.errors.DdsError`). A suction fault seen through the gripper feedback is the
+project's :class:`ur3hanoi.errors.SuctionFaultError` (exit code 3), as in ``ur3hanoi solve``.
 """
 
 from __future__ import annotations
@@ -10,10 +11,5 @@ from __future__ import annotations
 from ur3hanoi.errors import Ur3HanoiError
 
 
-class RosError(Ur3HanoiError):
-    """The middleware is missing, no master/peer answers, a node did not answer in time, or a message does not
-    match."""
-
-
-class CommandError(RosError):
-    """A command message the station refuses (wrong length, not finite, outside the joint limits, too long)."""
+class CommandError(Ur3HanoiError):
+    """A command message the server refuses (wrong length, not finite, outside the joint limits, too long)."""

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.interface.errors import RosError
+from ur3hanoi.errors import InputError, SimulationError
 
 
 class _StoppedError(Exception):
@@ -82,7 +82,7 @@ class FrameProcess:
     :meth:`close`.
 
     Raises:
-        RosError: the child could not set up rendering (its error, one line).
+        SimulationError: the child could not set up rendering (its error, one line).
     """
 
     def __init__(self, calibration: str, n_blocks: int, frames: Path | None, video: Path | None,
@@ -99,11 +99,11 @@ class FrameProcess:
         self.rendered = 0
         if not self._conn.poll(start_timeout_s):
             self._kill()
-            raise RosError(f"the rendering process did not start within {start_timeout_s:g} s")
+            raise SimulationError(f"the rendering process did not start within {start_timeout_s:g} s")
         hello = self._conn.recv()
         if not str(hello).startswith("ready"):
             self._kill()
-            raise RosError(f"offscreen rendering failed: {str(hello).removeprefix('error: ')}")
+            raise SimulationError(f"offscreen rendering failed: {str(hello).removeprefix('error: ')}")
         self.fps = float(str(hello).split()[1])
 
     def _collect(self) -> None:
@@ -142,3 +142,44 @@ class FrameProcess:
         if self._proc.is_alive():
             self._proc.kill()
             self._proc.join(10)
+
+
+class FrameOutput:
+    """A server's ``--frames``/``--video``: the rendering process (:class:`FrameProcess`, started by :meth:`open`
+    before the transport starts threads, so a slow start cannot delay messages), offered the joint state once per
+    frame period of world time, and its counts (final once :meth:`close` d)."""
+
+    def __init__(self, calibration: str, n_blocks: int, frames: Path | None, video: Path | None) -> None:
+        if frames is not None and video is not None:
+            raise InputError("give at most one of frames (a PNG folder) and video (an MP4 file)")
+        self.calibration, self.n_blocks, self.frames, self.video = calibration, n_blocks, frames, video
+        self._process: FrameProcess | None = None
+        self._final: dict[str, int] | None = None
+        self._next_frame_s = 0.0  # world time of the next frame [s]
+
+    def open(self, world_time_s: float) -> None:
+        """Start the rendering process (nothing without an output, or when it runs already)."""
+        if self._process is not None or (self.frames is None and self.video is None):
+            return
+        self._process = FrameProcess(self.calibration, self.n_blocks, self.frames, self.video)
+        self._next_frame_s = world_time_s
+
+    def close(self) -> None:
+        """Finish the PNG folder or video and stop the process; nothing when not rendering or already closed."""
+        if self._process is not None and self._final is None:
+            self._final = self._process.close()
+
+    def offer(self, world_time_s: float, qpos: FloatArray) -> None:
+        """Send the joint state when a frame period of world time has passed."""
+        process = self._process
+        if process is None or self._final is not None or world_time_s + 1e-9 < self._next_frame_s:
+            return
+        process.offer(qpos)
+        self._next_frame_s += 1.0 / process.fps
+
+    def counts(self) -> dict[str, int] | None:
+        """``{"rendered": n, "dropped": n}`` (None when not rendering)."""
+        if self._final is not None:
+            return self._final
+        return None if self._process is None else {"rendered": self._process.rendered,
+                                                   "dropped": self._process.dropped}

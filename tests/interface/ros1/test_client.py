@@ -7,8 +7,9 @@ import sys
 import pytest
 
 from tests.support.ros_support import free_port, requires_ros, ros_env, roscore, run
-from ur3hanoi.interface.errors import RosError
+from ur3hanoi.errors import DriverError
 from ur3hanoi.interface.ros1.client import RosArm
+from ur3hanoi.interface.ros1.errors import RosError
 
 
 def test_connect_without_a_master_fails_at_once():
@@ -26,7 +27,7 @@ def test_connect_to_a_master_without_a_driver_times_out_naming_the_topics(tmp_pa
     with roscore(env):
         result = run([sys.executable, "-c", code], env, 60.0)
     assert result.returncode != 0
-    assert ("RosError: no ur3/position, ur3/gripper_input, a ur3/command subscriber within 1 s on "
+    assert ("DriverError: no ur3/position, ur3/gripper_input, a ur3/command subscriber within 1 s on "
             f"{env['ROS_MASTER_URI']}: is ros-station or the course's ur3_driver running?") in result.stderr
 
 
@@ -50,7 +51,7 @@ def test_a_driver_that_stops_publishing_is_named_within_the_position_timeout(mon
     arm._pub = _Pub()
     monkeypatch.setattr(arm, "_publish", lambda goal, io, v, a: object())
     arm._on_position(type("P", (), {"position": [0.0] * 6})())  # one message, then silence
-    with pytest.raises(RosError, match=r"position updates stopped: no message on /ur3/position for 0\.\d s"):
+    with pytest.raises(DriverError, match=r"position updates stopped: no message on /ur3/position for 0\.\d s"):
         arm.move(np.full(6, 0.657))
 
 

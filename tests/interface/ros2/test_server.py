@@ -17,7 +17,7 @@ import pytest
 from tests.support import REPO, SUPPORT
 from tests.support.ros2_support import in_netns, requires_netns
 from ur3hanoi.interface.ros2.dds import LEASE_DURATION_S, cyclone_config
-from ur3hanoi.interface.ros2.server import BRIDGE_MOVE_S, Ros2Station, Ros2StationOptions, bridge_speed
+from ur3hanoi.interface.ros2.server import BRIDGE_MOVE_S, Ros2Server, Ros2ServerOptions, bridge_speed
 from ur3hanoi.robot.movej import plan_movej
 from ur3hanoi.station.calibration import load_station
 
@@ -35,7 +35,7 @@ def test_bridge_speed_gives_the_bridges_fixed_2_s_move(delta: float) -> None:
 
 def test_station_drops_non_6_destinations_and_converts_the_course_convention() -> None:
     logged: list[str] = []
-    st = Ros2Station(Ros2StationOptions(), out=lambda s: None, log=logged.append)
+    st = Ros2Server(Ros2ServerOptions(), out=lambda s: None, log=logged.append)
     home = np.array(st.station.q_home)
     assert st.position() == pytest.approx(home - np.array([math.pi / 2, 0, 0, -math.pi / 2, 0, 0]), abs=1e-6)
     assert not st.handle([0.0] * 5, 0.0, 0.0, True)  # v = a = 0 would be refused by ros-station; the bridge ignores
@@ -43,7 +43,7 @@ def test_station_drops_non_6_destinations_and_converts_the_course_convention() -
                       "joint angles [rad]"]
     course = home - np.array([math.pi / 2, 0, 0, -math.pi / 2, 0, 0]) + np.array([0.1, 0, 0, 0, 0, 0])
     assert st.handle(course.tolist(), 0.0, 0.0, False)
-    queued = st.driver.queue[-1]
+    queued = st.controller.queue[-1]
     assert queued.destination == pytest.approx(home + np.array([0.1, 0, 0, 0, 0, 0]), abs=1e-12)
     assert st.is_ready  # always, with the bridge's timing
     assert st.report()["suction"]["profile"] == "real" and st.report()["station"]["robot"] == "ur3e"
@@ -115,10 +115,10 @@ exit $CODE
 COURSE_OFFSET = np.array([math.pi / 2, 0, 0, -math.pi / 2, 0, 0])
 
 
-def _run_until_idle(st: Ros2Station, max_cycles: int) -> None:
+def _run_until_idle(st: Ros2Server, max_cycles: int) -> None:
     for _ in range(max_cycles):
         st.cycle()
-        if not st.driver.queue and st.driver.ready:
+        if not st.controller.queue and st.controller.ready:
             return
     raise AssertionError(f"the station did not come to rest within {max_cycles} cycles")
 
@@ -150,7 +150,7 @@ def test_absurd_commands_are_refused_with_a_log_line_and_the_next_command_runs()
     from ur3hanoi.interface.controller import MAX_MOVE_S
 
     logged: list[str] = []
-    st = Ros2Station(Ros2StationOptions(timing="honest"), out=lambda s: None, log=logged.append)
+    st = Ros2Server(Ros2ServerOptions(timing="honest"), out=lambda s: None, log=logged.append)
     home = np.array(st.position())
     near, bad = _absurd(home)
     for fields in bad:
@@ -168,7 +168,7 @@ def test_absurd_commands_are_refused_with_a_log_line_and_the_next_command_runs()
     assert np.max(np.abs(np.array(st.position()) - home)) < 1e-6  # no motion
     st.on_command(SimpleNamespace(destination=near, v=4.0, a=4.0, io_0=False))
     _run_until_idle(st, 1000)
-    assert st.driver.n_executed == 1
+    assert st.controller.n_executed == 1
     assert np.max(np.abs(np.array(st.position()) - np.array(near))) < 5e-4
 
 
@@ -176,19 +176,19 @@ def test_bridge_timing_ignores_v_and_a_but_refuses_bad_destinations_for_themselv
     """The bridge ignores v and a: v = a = 5e-324 is a 2 s move; a NaN destination is refused naming the angle
     (not the NaN speed the 2 s timing derives from it); out-of-limit angles are refused."""
     logged: list[str] = []
-    st = Ros2Station(Ros2StationOptions(), out=lambda s: None, log=logged.append)
+    st = Ros2Server(Ros2ServerOptions(), out=lambda s: None, log=logged.append)
     home = np.array(st.position())
     near, _ = _absurd(home)
     assert not st.handle([near[0], math.nan, *near[2:]], 1.0, 1.0, False)
     assert not st.handle([near[0], math.inf, *near[2:]], 1.0, 1.0, False)
     assert not st.handle([7.0, *near[1:]], 1.0, 1.0, False)
-    reasons = [r.reason for r in st.driver.rejected]
+    reasons = [r.reason for r in st.controller.rejected]
     assert reasons[:2] == ["destination[1] = nan is invalid: expected a finite angle [rad]",
                            "destination[1] = inf is invalid: expected a finite angle [rad]"]
     assert reasons[2].startswith("destination[0] = ") and "outside joint 1's limits" in reasons[2]
     assert st.handle(near, 5e-324, 5e-324, False)
     _run_until_idle(st, 1000)
-    assert [m.duration_s for m in st.driver.executed] == [pytest.approx(BRIDGE_MOVE_S, abs=1e-9)]
+    assert [m.duration_s for m in st.controller.executed] == [pytest.approx(BRIDGE_MOVE_S, abs=1e-9)]
     assert np.max(np.abs(np.array(st.position()) - np.array(near))) < 5e-4
     assert len(logged) == 1  # the first refusal at once; the others wait for the next second's summary
 
@@ -213,7 +213,7 @@ def test_absurd_commands_over_dds_are_refused_and_sigterm_stops_the_station_clea
     refused with log lines and no motion; the next command runs; SIGUSR1 writes a report without stopping;
     SIGTERM stops the station with exit 0 and its final report; nothing it started is left."""
     report = tmp_path / "report.json"
-    home = np.array(Ros2Station(Ros2StationOptions(), out=lambda s: None).position())
+    home = np.array(Ros2Server(Ros2ServerOptions(), out=lambda s: None).position())
     near, bad = _absurd(home)
     good = [{"destination": near, "v": 4.0, "a": 4.0, "io_0": False}]
     script = f"""
@@ -249,7 +249,7 @@ def test_a_1_khz_command_flood_over_dds_stays_bounded_and_sigint_stops_the_stati
     """1 kHz of commands for 4 s (bridge timing: the queue fills, most are refused): ur3e/position keeps coming,
     log lines stay about one per second, the report small; SIGINT stops the station cleanly."""
     report = tmp_path / "report.json"
-    home = Ros2Station(Ros2StationOptions(), out=lambda s: None).position()
+    home = Ros2Server(Ros2ServerOptions(), out=lambda s: None).position()
     near = [home[0] + 0.05, *home[1:]]
     fields = [{"destination": near, "v": 4.0, "a": 4.0, "io_0": False},
               {"destination": home, "v": 4.0, "a": 4.0, "io_0": True}]

@@ -9,7 +9,7 @@ Modules, one concept each (importing this package needs neither rospy nor MuJoCo
 - :mod:`~ur3hanoi.interface.ros1.master`: ``ROS_MASTER_URI``; find, start and stop a ``roscore`` (loopback by default).
 - :mod:`~ur3hanoi.interface.ros1.guard`: the process that keeps a started roscore from outliving the station (even
   SIGKILL).
-- :mod:`~ur3hanoi.interface.ros1.server`: the ``ros-station`` node (:class:`~ur3hanoi.interface.server.StationCore` on
+- :mod:`~ur3hanoi.interface.ros1.server`: the ``ros-station`` node (:class:`~ur3hanoi.interface.server.ServerCore` on
   rospy).
 - :mod:`~ur3hanoi.interface.ros1.client`: the rospy client (:class:`~ur3hanoi.interface.ros1.client.RosArm`, a
   :class:`~ur3hanoi.interface.client.TopicArm`).

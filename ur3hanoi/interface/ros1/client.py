@@ -18,7 +18,7 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.interface.client import ArmConfig, TopicArm, Topics
-from ur3hanoi.interface.errors import RosError
+from ur3hanoi.interface.ros1.errors import RosError
 
 TOPICS = Topics(command="ur3/command", position="ur3/position", gripper="ur3/gripper_input")
 

@@ -1,10 +1,13 @@
-"""Errors of the ROS 1 binding. :class:`~ur3hanoi.interface.errors.RosError` (and the station's
-:class:`~ur3hanoi.interface.errors.CommandError`) are the transport-neutral ones of :mod:`ur3hanoi.interface.errors`.
-"""
+"""Errors of the ROS 1 binding: ROS 1 itself failed (no master answers, roscore does not start, rospy is missing)."""
 
 from __future__ import annotations
 
-from ur3hanoi.interface.errors import RosError
+from ur3hanoi.errors import DriverError
+
+
+class RosError(DriverError):
+    """No ROS master answers (or something else holds its port), roscore did not start, a node did not answer in
+    time, or a message does not match the course's."""
 
 
 class RosUnavailableError(RosError):

@@ -38,8 +38,8 @@ from types import TracebackType
 from typing import Any
 from urllib.parse import urlsplit
 
-from ur3hanoi.interface.errors import RosError
 from ur3hanoi.interface.ros1.env import roscore_executable
+from ur3hanoi.interface.ros1.errors import RosError
 
 DEFAULT_MASTER_URI = "http://localhost:11311"
 

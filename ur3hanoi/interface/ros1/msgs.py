@@ -19,8 +19,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from ur3hanoi.interface.errors import RosError
 from ur3hanoi.interface.ros1.env import SITECUSTOMIZE, ensure_ros_python
+from ur3hanoi.interface.ros1.errors import RosError
 
 PACKAGE = "ur3_driver"
 

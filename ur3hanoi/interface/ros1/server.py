@@ -25,8 +25,8 @@ connections; nodes started now find the station); a master it did not start, or 
 the station: report written, one error line, exit 2. The report's ``master_events`` records what happened.
 
 A flood cannot stall the loop: the ROS callbacks only append to the bounded inbox
-(:data:`~ur3hanoi.interface.server.INBOX_MAX` messages), log lines are rate-limited and the records bounded
-(:class:`~ur3hanoi.interface.server.StationCore`).
+(:data:`~ur3hanoi.interface.inbox.INBOX_MAX` messages), log lines are rate-limited and the records bounded
+(:class:`~ur3hanoi.interface.server.ServerCore`).
 
 Listening: the station and the roscore it starts bind and advertise ``host`` (``ROS_IP``), by default
 ``127.0.0.1``: nothing on the lab network can reach them. ``--host ADDR`` (this machine's address on the lab
@@ -37,9 +37,9 @@ Output: the ready line and every info line go to ``info`` (the CLI: stderr); sta
 JSON report when there is no ``--report`` file.
 
 ``--frames``/``--video`` render in a separate low-priority process (:mod:`ur3hanoi.interface.render`, started by
-:meth:`~ur3hanoi.interface.server.StationCore.rendering`), which drops frames rather than stall the loop.
+:meth:`~ur3hanoi.interface.server.ServerCore.rendering`), which drops frames rather than stall the loop.
 
-The JSON report (:meth:`RosStation.report`): commands executed (with duration, settle time and rest error),
+The JSON report (:meth:`RosServer.report`): commands executed (with duration, settle time and rest error),
 refused, suction events, faults, final block positions (tower/height, or none = off-grid), loop timing, rendered
 frames. It is
 written on SIGINT/SIGTERM and at the end of ``--duration``, and on SIGUSR1 without stopping: to ``--report FILE``
@@ -51,13 +51,12 @@ from __future__ import annotations
 import ipaddress
 import os
 import sys
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from ur3hanoi.interface.errors import RosError
-from ur3hanoi.interface.server import CoreOptions, StationCore
+from ur3hanoi.interface.ros1.errors import RosError
+from ur3hanoi.interface.server import ServerCore, ServerOptions
 
 READY_LINE = "ur3hanoi ros-station: ready"
 """Written (and flushed) on stderr once the node is up: scripts wait for it."""
@@ -66,8 +65,8 @@ NODE_NAME = "ur3hanoi_station"
 
 
 @dataclass(frozen=True)
-class StationOptions(CoreOptions):
-    """What ``ur3hanoi ros-station`` runs: :class:`~ur3hanoi.interface.server.CoreOptions` and
+class RosServerOptions(ServerOptions):
+    """What ``ur3hanoi ros-station`` runs: :class:`~ur3hanoi.interface.server.ServerOptions` and
 
     Attributes:
         master_uri: ROS master (None: ``ROS_MASTER_URI``, else http://localhost:11311).
@@ -79,7 +78,7 @@ class StationOptions(CoreOptions):
     host: str = "127.0.0.1"
 
 
-class RosStation(StationCore):
+class RosServer(ServerCore):
     """The ``ros-station`` node (see the module docstring). :meth:`run` blocks until stopped.
 
     Args:
@@ -88,12 +87,12 @@ class RosStation(StationCore):
         report_out: where the JSON report goes without ``options.report`` (default: print to stdout, flushed).
     """
 
-    options: StationOptions
+    options: RosServerOptions
 
     TOPIC_LOG: ClassVar[dict[str, str]] = {"command": "ur3/command rejected, the arm does not move",
                                            "spawn": "ur3hanoi/spawn", "remove": "ur3hanoi/remove_block"}
 
-    def __init__(self, options: StationOptions, out: Callable[[str], None] | None = None,
+    def __init__(self, options: RosServerOptions, out: Callable[[str], None] | None = None,
                  report_out: Callable[[str], None] | None = None) -> None:
         from ur3hanoi.interface.ros1.master import MasterUri, is_loopback, master_uri_from_env
 
@@ -137,7 +136,7 @@ class RosStation(StationCore):
 
     # ------------------------------------------------------------------------------------------------ master
     def _master_event(self, event: str, **fields: Any) -> None:
-        wall = time.perf_counter() - self._wall0 if self._wall0 else 0.0
+        wall = self.clock.wall_s
         self.master_events.append({"wall_time_s": round(wall, 3), "event": event, **fields})
 
     def _master_lost(self, reason: str) -> int | None:
@@ -220,7 +219,7 @@ class RosStation(StationCore):
 
         def publish() -> None:
             fb = w.feedback()
-            pub_pos.publish(msgs.position(position=[float(x) for x in w.q], isReady=self.driver.ready))
+            pub_pos.publish(msgs.position(position=[float(x) for x in w.q], isReady=self.controller.ready))
             pub_grip.publish(msgs.gripper_input(DIGIN=fb.digin, AIN0=fb.ain0, AIN1=0.0))
 
         st = self.station

@@ -23,7 +23,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from ur3hanoi.interface.errors import RosError
+from ur3hanoi.interface.ros1.errors import RosError
 from ur3hanoi.interface.ros1.master import MasterUri, probe_master
 
 WATCH_PERIOD_S = 0.25

@@ -61,7 +61,7 @@ class Ros2Arm(TopicArm):
         """Join the domain and wait for the bridge's position and feedback and a ``ur3e/command`` subscriber.
 
         Raises:
-            RosError: they do not appear within ``connect_timeout_s``.
+            DriverError: they do not appear within ``connect_timeout_s``.
         """
         from ur3hanoi.interface.ros2.dds import Ros2Node
         from ur3hanoi.interface.ros2.msgs import CommandUR3e, GripperInput, Int32, PositionUR3e

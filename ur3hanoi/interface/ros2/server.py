@@ -21,14 +21,14 @@ command as the UR controller's ``movej`` at the message's ``v``/``a`` (capped at
 ``is_ready`` says whether the arm has arrived, as ``ros-station`` does.
 
 The world, command checks, motion, suction, the real-time loop, the bounded inbox, rate-limited log lines and
-the report are the transport-neutral station's (:class:`ur3hanoi.interface.server.StationCore`), shared with
+the report are the transport-neutral station's (:class:`ur3hanoi.interface.server.ServerCore`), shared with
 ``ros-station``; only the transport (:mod:`ur3hanoi.interface.ros2.dds`) differs: the loop takes at most 50 messages a
 cycle from each DDS reader (whose history is itself bounded by the QoS depth). Refusals are logged at most once
 a second per topic, with counts. The JSON report (SIGINT/SIGTERM, ``duration_s``; SIGUSR1 without stopping)
 has ``ros-station``'s sections plus ``transport``.
 
 ``--frames``/``--video`` render in a separate low-priority process that drops frames rather than stall the loop
-(:meth:`~ur3hanoi.interface.server.StationCore.rendering`, as ``ros-station``); the report's ``frames`` counts them.
+(:meth:`~ur3hanoi.interface.server.ServerCore.rendering`, as ``ros-station``); the report's ``frames`` counts them.
 """
 
 from __future__ import annotations
@@ -42,8 +42,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ur3hanoi.interface.errors import RosError
-from ur3hanoi.interface.server import CoreOptions, StationCore
+from ur3hanoi.errors import InputError
+from ur3hanoi.interface.ros2.errors import DdsError
+from ur3hanoi.interface.server import ServerCore, ServerOptions
 from ur3hanoi.robot.convention import from_controller, to_controller
 
 READY_LINE = "ur3hanoi ros2-station: ready"
@@ -64,8 +65,8 @@ TOPIC_REMOVE = "ur3hanoi/remove_block"
 
 
 @dataclass(frozen=True)
-class Ros2StationOptions(CoreOptions):
-    """What ``ur3hanoi ros2-station`` runs: :class:`~ur3hanoi.interface.server.CoreOptions` (the calibration
+class Ros2ServerOptions(ServerOptions):
+    """What ``ur3hanoi ros2-station`` runs: :class:`~ur3hanoi.interface.server.ServerOptions` (the calibration
     ``ur3e_sim`` by default) and
 
     Attributes:
@@ -94,7 +95,7 @@ def bridge_speed(start: np.ndarray, destination: np.ndarray, duration_s: float =
     return 2.0 * dist / duration_s, 4.0 * dist / (duration_s * duration_s)
 
 
-class Ros2Station(StationCore):
+class Ros2Server(ServerCore):
     """The ``ros2-station`` node (see the module docstring). :meth:`run` blocks until stopped.
 
     Args:
@@ -103,26 +104,26 @@ class Ros2Station(StationCore):
         log: where log lines go (default: stderr).
     """
 
-    options: Ros2StationOptions
+    options: Ros2ServerOptions
 
     TOPIC_LOG: ClassVar[dict[str, str]] = {"command": f"{TOPIC_COMMAND} dropped, the arm does not move",
                                            "spawn": TOPIC_SPAWN, "remove": TOPIC_REMOVE}
 
-    def __init__(self, options: Ros2StationOptions, out: Callable[[str], None] | None = None,
+    def __init__(self, options: Ros2ServerOptions, out: Callable[[str], None] | None = None,
                  log: Callable[[str], None] | None = None) -> None:
         from ur3hanoi.interface.ros2.dds import domain_id_from_env
 
         if options.timing not in TIMINGS:
-            raise RosError(f"timing {options.timing!r} is invalid: expected one of {', '.join(TIMINGS)}")
+            raise InputError(f"timing {options.timing!r} is invalid: expected one of {', '.join(TIMINGS)}")
         if options.convention not in ("course", "controller"):
-            raise RosError(f"convention {options.convention!r} is invalid: expected course or controller")
+            raise InputError(f"convention {options.convention!r} is invalid: expected course or controller")
         printed = out if out is not None else (lambda s: print(s, flush=True))
         self._log_line = log if log is not None else (lambda s: print(s, file=sys.stderr, flush=True))
         super().__init__(options, printed, printed)
         try:
             self.domain_id = domain_id_from_env() if options.domain_id is None else options.domain_id
         except ValueError as exc:
-            raise RosError(str(exc)) from None
+            raise InputError(str(exc)) from None
         self.received = 0
 
     def _emit(self, level: str, text: str) -> None:
@@ -134,14 +135,14 @@ class Ros2Station(StationCore):
         self.received += 1
         values = list(msg.destination)
         if len(values) != 6:
-            raise self.driver.refuse(f"destination has {len(values)} values: expected 6 joint angles [rad]")
+            raise self.controller.refuse(f"destination has {len(values)} values: expected 6 joint angles [rad]")
         q = to_controller(np.array(values, dtype=float), self.options.convention)
         v, a = msg.v, msg.a
         if self.options.timing == "bridge":
-            queue = self.driver.queue
+            queue = self.controller.queue
             start = np.array(queue[-1].destination) if queue else self.world.target
             v, a = bridge_speed(start, q)  # the bridge ignores v and a (a bad destination is named first)
-        self.driver.submit(q.tolist(), v, a, msg.io_0)
+        self.controller.submit(q.tolist(), v, a, msg.io_0)
 
     def handle(self, destination: Any, v: float, a: float, io_0: bool) -> bool:
         """One ``ur3e/command`` now: convert, check and queue it (True), or log why it is dropped (False)."""
@@ -150,7 +151,7 @@ class Ros2Station(StationCore):
     @property
     def is_ready(self) -> bool:
         """``is_ready``: always true with the bridge's timing; the arm has arrived with ``honest``."""
-        return True if self.options.timing == "bridge" else self.driver.ready
+        return True if self.options.timing == "bridge" else self.controller.ready
 
     def position(self) -> list[float]:
         """The published joint angles [rad] in the topic's convention."""
@@ -173,7 +174,7 @@ class Ros2Station(StationCore):
             try:
                 node = Ros2Node(NODE_NAME, self.domain_id, self.options.network)
             except Exception as exc:  # the DDS library's own errors (bad interface, no free participant index)
-                raise RosError(f"cannot start the DDS participant on network {self.options.network!r}: {exc}") \
+                raise DdsError(f"cannot start the DDS participant on network {self.options.network!r}: {exc}") \
                     from None
             try:
                 commands = node.subscription(TOPIC_COMMAND, CommandUR3e)
