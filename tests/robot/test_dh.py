@@ -10,25 +10,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.se3 import rot_x, rot_z, trans
 from ur3hanoi.robot.dh import dh_fk, dh_frames, dh_link, dh_matrix
 from ur3hanoi.robot.registry import UR3, UR3E, RobotDescription
-
-
-def _rot_z(t: float) -> np.ndarray:
-    c, s = math.cos(t), math.sin(t)
-    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-
-
-def _rot_x(t: float) -> np.ndarray:
-    c, s = math.cos(t), math.sin(t)
-    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
-
-
-def _trans(x: float, y: float, z: float) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, 3] = (x, y, z)
-    return T
-
 
 ANGLE = st.floats(-2 * math.pi, 2 * math.pi)
 LENGTH = st.floats(-1.0, 1.0)
@@ -37,7 +21,7 @@ LENGTH = st.floats(-1.0, 1.0)
 @settings(max_examples=200, deadline=None)
 @given(ANGLE, LENGTH, LENGTH, ANGLE)
 def test_dh_matrix_is_the_four_elementary_transforms(theta: float, d: float, a: float, alpha: float) -> None:
-    expected = _rot_z(theta) @ _trans(0, 0, d) @ _trans(a, 0, 0) @ _rot_x(alpha)
+    expected = rot_z(theta) @ trans(0, 0, d) @ trans(a, 0, 0) @ rot_x(alpha)
     np.testing.assert_allclose(dh_matrix(theta, d, a, alpha), expected, rtol=0.0, atol=1e-15)
 
 
@@ -63,7 +47,7 @@ def test_fk_composes_the_joints_and_its_frames_are_the_partial_products(robot: R
     for n, q in enumerate(qs):
         T = np.eye(4)
         for i in range(6):
-            T = T @ _rot_z(q[i]) @ _trans(0, 0, robot.dh.d[i]) @ _trans(robot.dh.a[i], 0, 0) @ _rot_x(robot.dh.alpha[i])
+            T = T @ rot_z(q[i]) @ trans(0, 0, robot.dh.d[i]) @ trans(robot.dh.a[i], 0, 0) @ rot_x(robot.dh.alpha[i])
             np.testing.assert_allclose(frames[i][n], H @ T, rtol=0.0, atol=1e-14)
         np.testing.assert_allclose(batch[n], T, rtol=0.0, atol=1e-14)
 

@@ -10,6 +10,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from tests.support.se3 import rot_x, rot_z, trans
 from ur3hanoi.robot.dh import dh_fk
 from ur3hanoi.robot.ik import analytic_ik, branch_of, wrap_angle
 from ur3hanoi.robot.model import load_ur3
@@ -17,27 +18,11 @@ from ur3hanoi.robot.registry import UR3, UR3E, RobotDescription
 from ur3hanoi.robot.urdf import JOINT_NAMES, link_inertias, urdf_from_dh
 
 
-def _rot_z(t: float) -> np.ndarray:
-    c, s = math.cos(t), math.sin(t)
-    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-
-
-def _rot_x(t: float) -> np.ndarray:
-    c, s = math.cos(t), math.sin(t)
-    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
-
-
-def _trans(x: float, y: float, z: float) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, 3] = (x, y, z)
-    return T
-
-
 def independent_dh(q: np.ndarray, r: RobotDescription, upto: int = 6) -> np.ndarray:
     """Textbook standard DH written out as four elementary transforms per joint (not the package's fused form)."""
     T = np.eye(4)
     for i in range(upto):
-        T = T @ _rot_z(q[i]) @ _trans(0, 0, r.dh.d[i]) @ _trans(r.dh.a[i], 0, 0) @ _rot_x(r.dh.alpha[i])
+        T = T @ rot_z(q[i]) @ trans(0, 0, r.dh.d[i]) @ trans(r.dh.a[i], 0, 0) @ rot_x(r.dh.alpha[i])
     return T
 
 
