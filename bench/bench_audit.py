@@ -29,7 +29,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from tests import recorded_tables as rt  # noqa: E402
+from tests.support import recorded_tables as rt  # noqa: E402
 from ur3hanoi.audit import audit_table  # noqa: E402
 from ur3hanoi.station.calibration import load_station  # noqa: E402
 from ur3hanoi.station.grid import ON  # noqa: E402

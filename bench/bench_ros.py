@@ -34,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 REPO = Path(__file__).resolve().parents[1]
+SUPPORT = REPO / "tests" / "support"
 sys.path.insert(0, str(REPO))
 
 from ur3hanoi.interface.ros1.master import RosCore  # noqa: E402
@@ -116,7 +117,7 @@ def flood_once(tmp: Path, seconds: float) -> dict[str, Any]:
                 time.sleep(0.1)
             time.sleep(1.0)
             lines0 = len(errlog.read_text().splitlines())
-            publisher = subprocess.Popen([sys.executable, str(REPO / "tests" / "ros_publisher.py"), "--flood", "1000",
+            publisher = subprocess.Popen([sys.executable, str(SUPPORT / "ros_publisher.py"), "--flood", "1000",
                                           str(seconds), json.dumps(fields)], env=env, stdout=subprocess.PIPE,
                                          stderr=subprocess.PIPE, text=True)
             samples = []  # (time [s], VmRSS [kB]) every 0.25 s while the publisher runs
@@ -192,7 +193,7 @@ def main() -> int:
         subprocess.run(cli("tables", "lab_sim", "--key", "sim_pos", "-o", str(table)), check=True,
                        capture_output=True)
         env_cmd = shlex.join(cli("ros-env", "--dir", str(tmp / "ros-env")))
-        program = shlex.join([sys.executable, str(REPO / "tests" / "lab2_exec_starter.py"), "--yaml", str(table)])
+        program = shlex.join([sys.executable, str(SUPPORT / "lab2_exec_starter.py"), "--yaml", str(table)])
         wall, rep = run_against_station(tmp, ["bash", "-c", f'eval "$({env_cmd})" 2>/dev/null && exec {program}'],
                                         stdin="1\n3\n")
         rows.append(("lab-style lab2_exec_starter.py (v=a=4, 1 s grasp sleep)", wall, rep))
