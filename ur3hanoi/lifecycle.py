@@ -24,10 +24,8 @@ The commands that start processes take SIGTERM like SIGINT (:func:`sigterm_raise
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import os
 import signal
-import threading
 from collections.abc import Callable, Iterable, Iterator
 from types import FrameType
 
@@ -40,6 +38,8 @@ STOP_SIGNALS: tuple[signal.Signals, ...] = (signal.SIGINT, signal.SIGTERM)
 def prctl(option: int, value: int) -> None:
     """Linux ``prctl(option, value)`` (a no-op where libc has none)."""
     with contextlib.suppress(AttributeError, OSError):
+        import ctypes  # here: every command imports this module, only the ones that start processes need it
+
         ctypes.CDLL(None, use_errno=True).prctl(option, value, 0, 0, 0)
 
 
@@ -94,10 +94,11 @@ def _terminated(_signum: int, _frame: FrameType | None) -> None:
 def sigterm_raises() -> Iterator[None]:
     """Inside: SIGTERM raises :class:`Terminated` (a :class:`KeyboardInterrupt`) in the main thread, once; the
     previous handler is restored after. Elsewhere than in the main thread: nothing (Python signals need it)."""
-    if threading.current_thread() is not threading.main_thread():
+    try:
+        previous = signal.signal(signal.SIGTERM, _terminated)
+    except ValueError:  # not the main thread, where Python runs signal handlers: nothing to do
         yield
         return
-    previous = signal.signal(signal.SIGTERM, _terminated)
     try:
         yield
     finally:

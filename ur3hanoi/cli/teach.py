@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import shlex
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -254,6 +253,8 @@ def _finish(args: argparse.Namespace, base: Station, base_label: str, taught: Ta
 
 def _next_command(args: argparse.Namespace, station_out: Path, key: str, n_towers: int) -> str:
     """The first solve to try on the new table: from the blocks' tower to the last one (the first, from the last)."""
+    import shlex
+
     start = args.start
     end = n_towers if start != n_towers else 1
     cmd = ["ur3hanoi", _names(args).solve]
