@@ -23,29 +23,32 @@ if TYPE_CHECKING:
     from ur3hanoi.audit import audit_table
     from ur3hanoi.calibrate import fit_station
     from ur3hanoi.calibrate.taught import load_taught, taught_from_table
-    from ur3hanoi.errors import Ur3HanoiError
+    from ur3hanoi.errors import SuctionFaultError, Ur3HanoiError
     from ur3hanoi.hanoi import solve_hanoi
     from ur3hanoi.io.resources import stations_dir
     from ur3hanoi.plan import Phase, PlanConfig, plan_solve
-    from ur3hanoi.robot.ik import analytic_ik, solve_on_branch
-    from ur3hanoi.robot.ik_solvers import make_solver
-    from ur3hanoi.robot.model import load_ur3
+    from ur3hanoi.robot.dh import dh_fk
+    from ur3hanoi.robot.ik import analytic_ik, branch_of, solve_on_branch
+    from ur3hanoi.robot.ik_solvers import make_solver, pose_errors
+    from ur3hanoi.robot.model import T_BASELINK_BASE, load_ur3
     from ur3hanoi.sim import Faults, build_task_scene, run_plan
     from ur3hanoi.station.calibration import Station, load_station
-    from ur3hanoi.station.grid import ABOVE, ON, T_base_tcp, pose_label
+    from ur3hanoi.station.grid import ABOVE, ON, T_base_tcp, grid_targets_world, pose_label
     from ur3hanoi.tables import read_recorded_table, read_table, write_table
     from ur3hanoi.tables.ik_table import check_table, generate_table
 
 _HOME: dict[str, str] = {
     "audit_table": "audit", "fit_station": "calibrate",
     **dict.fromkeys(("load_taught", "taught_from_table"), "calibrate.taught"),
-    "Ur3HanoiError": "errors", "solve_hanoi": "hanoi", "stations_dir": "io.resources",
+    **dict.fromkeys(("SuctionFaultError", "Ur3HanoiError"), "errors"), "solve_hanoi": "hanoi",
+    "stations_dir": "io.resources",
     **dict.fromkeys(("Phase", "PlanConfig", "plan_solve"), "plan"),
-    **dict.fromkeys(("analytic_ik", "solve_on_branch"), "robot.ik"), "make_solver": "robot.ik_solvers",
-    "load_ur3": "robot.model",
+    "dh_fk": "robot.dh", **dict.fromkeys(("analytic_ik", "branch_of", "solve_on_branch"), "robot.ik"),
+    **dict.fromkeys(("make_solver", "pose_errors"), "robot.ik_solvers"),
+    **dict.fromkeys(("T_BASELINK_BASE", "load_ur3"), "robot.model"),
     **dict.fromkeys(("Faults", "build_task_scene", "run_plan"), "sim"),
     **dict.fromkeys(("Station", "load_station"), "station.calibration"),
-    **dict.fromkeys(("ABOVE", "ON", "T_base_tcp", "pose_label"), "station.grid"),
+    **dict.fromkeys(("ABOVE", "ON", "T_base_tcp", "grid_targets_world", "pose_label"), "station.grid"),
     **dict.fromkeys(("read_recorded_table", "read_table", "write_table"), "tables"),
     **dict.fromkeys(("check_table", "generate_table"), "tables.ik_table"),
 }
@@ -54,24 +57,30 @@ _HOME: dict[str, str] = {
 __all__ = [
     "ABOVE",
     "ON",
+    "T_BASELINK_BASE",
     "Faults",
     "Phase",
     "PlanConfig",
     "Station",
+    "SuctionFaultError",
     "T_base_tcp",
     "Ur3HanoiError",
     "__version__",
     "analytic_ik",
     "audit_table",
+    "branch_of",
     "build_task_scene",
     "check_table",
+    "dh_fk",
     "fit_station",
     "generate_table",
+    "grid_targets_world",
     "load_station",
     "load_taught",
     "load_ur3",
     "make_solver",
     "plan_solve",
+    "pose_errors",
     "pose_label",
     "read_recorded_table",
     "read_table",
