@@ -135,19 +135,25 @@ def base_env(source: Path, tmp: Path) -> dict[str, str]:
 # ---------------------------------------------------------------------------------------------------------- ROS 1
 
 
+def stop_timed(st: Proc, sig: signal.Signals, also_gone: Callable[[], bool] = lambda: True) -> dict[str, float | None]:
+    """Send ``sig`` to a ready station: how long until it exits (None for SIGKILL) and until it and every process
+    it started are gone (and ``also_gone()``), in seconds from the signal."""
+    st.wait_ready()
+    below = descendants(st.proc.pid)
+    t0 = time.monotonic()
+    os.kill(st.proc.pid, sig)
+    exit_s = None if sig == signal.SIGKILL else wait_for(lambda: st.proc.poll() is not None)
+    clean = wait_for(lambda: st.proc.poll() is not None and not any(alive(p) for p in below) and also_gone())
+    return {"exit_s": exit_s, "clean_s": None if clean is None else time.monotonic() - t0}
+
+
 def ros1_stop(source: Path, tmp: Path, sig: signal.Signals) -> dict[str, float | None]:
     """Exit time and clean-up time [s] of a station with its own master after ``sig``."""
     port = free_port()
     env = dict(base_env(source, tmp), ROS_MASTER_URI=f"http://127.0.0.1:{port}")
     st = Proc(cli("ros-station", "--report", str(tmp / f"r{port}.json")), env, "ros-station: ready")
     try:
-        st.wait_ready()
-        below = descendants(st.proc.pid)
-        t0 = time.monotonic()
-        os.kill(st.proc.pid, sig)
-        exit_s = None if sig == signal.SIGKILL else wait_for(lambda: st.proc.poll() is not None)
-        clean = wait_for(lambda: st.proc.poll() is not None and not any(alive(p) for p in below) and port_free(port))
-        return {"exit_s": exit_s, "clean_s": None if clean is None else time.monotonic() - t0}
+        return stop_timed(st, sig, lambda: port_free(port))
     finally:
         st.kill_all()
 
@@ -196,13 +202,7 @@ def ros2_station(source: Path, tmp: Path, name: str) -> Proc:
 def ros2_stop(source: Path, tmp: Path, sig: signal.Signals) -> dict[str, float | None]:
     st = ros2_station(source, tmp, f"s{sig.value}-{time.monotonic_ns()}")
     try:
-        st.wait_ready()
-        below = descendants(st.proc.pid)
-        t0 = time.monotonic()
-        os.kill(st.proc.pid, sig)
-        exit_s = None if sig == signal.SIGKILL else wait_for(lambda: st.proc.poll() is not None)
-        clean = wait_for(lambda: st.proc.poll() is not None and not any(alive(p) for p in below))
-        return {"exit_s": exit_s, "clean_s": None if clean is None else time.monotonic() - t0}
+        return stop_timed(st, sig)
     finally:
         st.kill_all()
 
