@@ -134,6 +134,19 @@ def truth_base(truth: Station, real_base: Station) -> Station:
                    height_step=(0.0, 0.0, truth.block_size))
 
 
+def moved_base(truth: Station, base: Station, turn_deg: float = 2.0, shift_m: Sequence[float] = (0.012, -0.008, 0.0)
+               ) -> Station:
+    """``base`` with the truth's blocks and its tower layout, turned about the towers' centroid and moved as a whole:
+    a base calibration that says roughly where the towers stand (the fit must still come from the points)."""
+    o = np.asarray(truth.tower_origins)
+    c = o.mean(axis=0)
+    R = pin.utils.rotate("z", math.radians(turn_deg))
+    origins = (o - c) @ R.T + c + np.asarray(shift_m)
+    return replace(base, block_size=truth.block_size, contact_depth=truth.contact_depth,
+                   tower_origins=tuple((float(x), float(y), float(z)) for x, y, z in origins),
+                   height_step=(0.0, 0.0, truth.block_size))
+
+
 def write_base(path: Path, station: Station) -> Path:
     path.write_text(yaml.safe_dump(station_to_dict(station), sort_keys=False))
     return path
@@ -174,8 +187,7 @@ def test_one_mm_noise_stays_within_1p5_mm(real_base: Station, slots: tuple[Slot,
                                           seed: int) -> None:
     rng = np.random.default_rng(seed)
     truth = synthetic_station(rng, real_base)
-    base = replace(real_base, block_size=truth.block_size, contact_depth=truth.contact_depth)
-    fit = fit_station(base, teach(truth, slots, rng, noise_m=0.001))
+    fit = fit_station(moved_base(truth, real_base), teach(truth, slots, rng, noise_m=0.001))
     errs = contact_errors_m(truth, fit.station, ks=ks)
     assert np.max(errs) < 1.5e-3, f"worst regenerated pose off by {np.max(errs) * 1e3:.3f} mm"
     # 1 mm noise never looks like a mis-recorded point.
@@ -225,7 +237,7 @@ def test_yaw_is_the_circular_mean_and_deviations_warn(truth: Station, truth_base
         solver = make_solver("pinocchio", load_ur3(truth.tool, truth.limits))
         q = solve_on_branch(solver, truth.T_world_base.actInv(T), truth.q_home_array).q
         pts[i] = replace(pts[i], q=tuple(float(v) for v in q))
-    fit = fit_station(truth_base, pts)
+    fit = fit_station(moved_base(truth, truth_base), pts)
     assert math.degrees(float(np.angle(np.exp(1j * (fit.station.tool_yaw - truth.tool_yaw))))) == pytest.approx(
         0.0, abs=1e-2)
     assert fit.yaw_dev_deg[:2] == pytest.approx([3.0 - 0.0, -3.0], abs=0.05)
@@ -275,8 +287,9 @@ def test_underdetermined_points_are_refused(truth: Station, truth_base: Station)
 
 def test_cli_calibrate_then_tables_end_to_end(truth: Station, truth_base: Station, tmp_path: Path,
                                               capsys: pytest.CaptureFixture[str]) -> None:
-    base_file = write_base(tmp_path / "base.yaml", truth_base)
-    # The base's grid is not the truth's: the fit must come from the taught points.
+    base_file = write_base(tmp_path / "base.yaml", moved_base(truth, truth_base))
+    # The base's grid is not the truth's (it says roughly where the towers stand): the fit must come from the taught
+    # points.
     assert np.max(np.abs(np.subtract(load_station(base_file).tower_origins, truth.tower_origins))) > 0.01
     taught_file = write_taught(tmp_path / "taught.yaml", teach(truth, (*MINIMAL, (0, 2, ON), (1, 0, ABOVE))))
     out = tmp_path / "station.yaml"

@@ -212,19 +212,22 @@ class _Lts:
         candidates never do). The rank is followed with an orthonormal basis of the rows taken (Gram-Schmidt): the
         design holds 0, 1 and small integers, so a new row either adds a unit-size direction or none."""
         n_unknowns = self.model.n_unknowns
-        basis = np.zeros((0, n_unknowns))
+        basis = np.zeros((n_unknowns, n_unknowns))
+        rank = 0
         chosen: list[int] = []
         for i in order:
             grew = False
             for row in self.A[3 * int(i):3 * int(i) + 3]:
-                rest = row - (basis @ row) @ basis
-                norm = float(np.linalg.norm(rest))
+                taken = basis[:rank]
+                rest = row - (taken @ row) @ taken
+                norm = math.sqrt(float(rest @ rest))
                 if norm > 1e-9:
-                    basis = np.vstack([basis, rest / norm])
+                    basis[rank] = rest / norm
+                    rank += 1
                     grew = True
             if grew:
                 chosen.append(int(i))
-                if len(basis) == n_unknowns:
+                if rank == n_unknowns:
                     return np.array(chosen)
         return None
 
@@ -257,6 +260,8 @@ class _Lts:
         """The :data:`N_STARTS` best distinct trimmed fits' ``h`` closest candidates (indices), best first."""
         n = len(cand)
         h = min(n, (n + math.ceil(self.model.n_unknowns / 3) + 1) // 2)
+        if h == n:  # no point to trim: every subset's trimmed fit is the fit of them all
+            return [cand]
         rng = np.random.default_rng(_SEED)
         found: dict[tuple[int, ...], tuple[float, GridSolution]] = {}
         tried: set[tuple[int, ...]] = set()
