@@ -30,6 +30,8 @@ Module map:
   recorded in the wrong slot); :func:`~ur3hanoi.calibrate.explain.diagnose_contacts` with the heading left free.
 - :mod:`~ur3hanoi.calibrate.verdict`: what a student reads about the point the consensus named (the arm at home,
   the wrong slot, a typo in one joint, not on the block) and what to do.
+- :mod:`~ur3hanoi.calibrate.prepare`: the points a fit starts from: measured, the unusable set aside, the consensus
+  on the rest (also what teach shows after each record, :func:`~ur3hanoi.calibrate.prepare.taught_consensus`).
 - :mod:`~ur3hanoi.calibrate.fit`: :func:`fit_station`, the fit and the judgement of every point.
 - :mod:`~ur3hanoi.calibrate.result`: its result, :class:`CalibrationFit`, and :class:`Suspect` (also the audit's).
 - :mod:`~ur3hanoi.calibrate.output`: the calibration file written (refused when the fit is not sound).
@@ -46,8 +48,9 @@ The taught-points file and its checks are :mod:`ur3hanoi.calibrate.taught`.
 from __future__ import annotations
 
 from ur3hanoi.calibrate.explain import JOINT_LABELS, JointTypo, joint_typo
-from ur3hanoi.calibrate.fit import MAX_TILT_DEG, fit_station
+from ur3hanoi.calibrate.fit import fit_station
 from ur3hanoi.calibrate.output import calibration_text, write_calibration
+from ur3hanoi.calibrate.prepare import MAX_TILT_DEG
 from ur3hanoi.calibrate.result import CalibrationFit, ResidualRow, Suspect
 from ur3hanoi.calibrate.robust import (
     MIN_SUSPECT_DEG,

@@ -21,7 +21,8 @@ consistent when nothing is over its limit:
   weighed, never alone a reason (a round cup does not care, and freedrive turns it): a heading more than
   ``max(HEADING_DEG, 5 x the others' spread)`` from the others' counts against the point when hypotheses compete;
 - **the approach**: an above pose stands within :data:`ABOVE_FLAG_LINE_MM` (10 mm) of its tower's vertical line,
-  at least :data:`ABOVE_MIN_MM` (5 mm) and at most :data:`MAX_APPROACH_M` over its contact.
+  at least :data:`ABOVE_MIN_MM` (5 mm) and at most :data:`MAX_APPROACH_M` over its contact, and as high over it as
+  the other above poses (the calibration has one approach height): within ``max(8 mm, 5 x their spread)``.
 
 The decision: when all the candidates are consistent, no point is grossly wrong (``agree``). Otherwise each
 candidate is left out in turn (not the ``accepted`` ones). Among the hypotheses that leave the rest consistent,
@@ -72,9 +73,10 @@ BY_POINTS, BY_LAYOUT = "points", "layout"
 
 @dataclass(frozen=True)
 class Check:
-    """One piece of evidence about a set of points: ``what`` it is about (``point``, ``tilt``, ``above``, ``approach``,
-    ``step``, ``layout``, ``heading``), the point (or, for ``layout``, the tower; -1 for ``step``) it judges, its
-    ``value`` [mm or deg] and its ``share`` of the limit (over 1: disagrees); ``soft`` checks are weighed only."""
+    """One piece of evidence about a set of points: ``what`` it is about (``point``, ``tilt``, ``above``, ``over``,
+    ``approach``, ``step``, ``layout``, ``heading``), the point (or, for ``layout``, the tower; -1 for ``step``) it
+    judges, its ``value`` [mm or deg] and its ``share`` of the limit (over 1: disagrees); ``soft`` checks are weighed
+    only."""
 
     what: str
     index: int
@@ -174,47 +176,66 @@ def _prior_step(base: Station, origins: FloatArray) -> FloatArray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ step
 
 
-def _design(ev: Evidence, rows: list[tuple[int, int]], axes: tuple[int, ...]) -> tuple[FloatArray, tuple[int, ...]]:
-    """Least-squares rows (point, axis): columns the towers' origins, then the step's ``axes``."""
+def _design(ev: Evidence, rows: list[tuple[int, int]], axes: tuple[int, ...], approach: bool) -> FloatArray:
+    """Least-squares rows (point, axis): columns the towers' origins, the step's ``axes``, then the approach."""
     n_t = ev.base.n_towers
-    A = np.zeros((len(rows), 3 * n_t + len(axes)))
+    A = np.zeros((len(rows), 3 * n_t + len(axes) + int(approach)))
     for r, (i, a) in enumerate(rows):
-        t, h, _ = ev.slots[i]
+        t, h, k = ev.slots[i]
         A[r, 3 * t + a] = 1.0
         if a in axes:
             A[r, 3 * n_t + axes.index(a)] = h
-    return A, axes
+        if approach and k == ABOVE and a == 2:
+            A[r, -1] = 1.0
+    return A
+
+
+def _model(ev: Evidence, idx: list[int], n_present: int
+           ) -> tuple[list[tuple[int, int]], FloatArray, tuple[int, ...], list[int]]:
+    """The rows, design and fitted step axes of the kept points ``idx``, and the points that fix the step.
+
+    Contacts count in x, y and z, above poses in x and y (their height is the approach's), unless nothing else
+    fixes a stacked step: then their heights do, with a shared approach (as in the calibration's own fit). A step
+    the points do not fix is the base's (no axes)."""
+    above = [i for i in idx if ev.slots[i][2] == ABOVE]
+    rows = [(i, a) for i in idx for a in ((0, 1, 2) if ev.slots[i][2] == ON else (0, 1))]
+    axes = (0, 1) if ev.base.layout == "flat" else (0, 1, 2)
+    A = _design(ev, rows, axes, False)
+    if rows and int(np.linalg.matrix_rank(A)) == 3 * n_present + len(axes):
+        fixing = [i for i in idx if ev.slots[i][2] == ON or ev.base.layout == "flat"]
+        return rows, A, axes, fixing
+    if above and ev.base.layout != "flat":
+        rows_z = rows + [(i, 2) for i in above]
+        A = _design(ev, rows_z, axes, True)
+        if int(np.linalg.matrix_rank(A)) == 3 * n_present + len(axes) + 1:
+            return rows_z, A, axes, idx
+    return rows, _design(ev, rows, (), False), (), []
 
 
 def _grid(ev: Evidence, kept: np.ndarray) -> tuple[FloatArray, FloatArray, bool, FloatArray, BoolArray, int]:
     """The grid of the kept points (contacts, and the horizontal place of above poses over a tower with a contact),
-    by least squares: (origins (T, 3) [m] NaN where no contact, step, fitted?, each point's deviation (N, 3) from
-    the grid of the others [m] (NaN where they cannot say; z NaN for an above pose), checkable (N,), the number of
-    towers taught at two heights or more)."""
+    by least squares (:func:`_model`): (origins (T, 3) [m] NaN where no contact, step, fitted?, each point's
+    deviation (N, 3) from the grid of the others [m] (NaN where they cannot say), checkable (N,), the number of
+    towers whose points fix the step)."""
     base, n_t, n = ev.base, ev.base.n_towers, len(ev.slots)
     idx = [int(i) for i in kept]
     present = np.zeros(n_t, dtype=bool)
     for i in idx:
         present[ev.slots[i][0]] |= ev.slots[i][2] == ON
     idx = [i for i in idx if present[ev.slots[i][0]]]
-    flat = base.layout == "flat"  # its step is horizontal: above poses place it as well as contacts
-    levels = [len({ev.slots[i][1] for i in idx if ev.slots[i][0] == t and (flat or ev.slots[i][2] == ON)})
-              for t in range(n_t)]
-    rows = [(i, a) for i in idx for a in ((0, 1, 2) if ev.slots[i][2] == ON else (0, 1))]
-    A, axes = _design(ev, rows, (0, 1) if flat else (0, 1, 2))
-    fitted = int(np.linalg.matrix_rank(A)) == 3 * int(present.sum()) + len(axes) if rows else False
-    if not fitted:
-        A, axes = _design(ev, rows, ())
+    rows, A, axes, fixing = _model(ev, idx, int(present.sum()))
+    fitted = bool(axes)
     p = np.array([ev.m.p_world[i, a] for i, a in rows])
     h_rows = np.array([ev.slots[i][1] for i, _ in rows], dtype=float)
     a_rows = np.array([a for _, a in rows], dtype=int)
-    step, origins = default_height_step(base, None), np.full((n_t, 3), np.nan)
+    step, origins, x = default_height_step(base, None), np.full((n_t, 3), np.nan), np.zeros(A.shape[1])
     for _ in range(1 if fitted else 3):  # an unfitted flat step turns with the towers it places
-        x = np.linalg.lstsq(A, p - (0.0 if fitted else h_rows * step[a_rows]), rcond=None)[0] if rows else np.zeros(0)
-        origins = np.where(present[:, None], x[:3 * n_t].reshape(n_t, 3), np.nan) if rows else origins
+        if rows:
+            x = np.linalg.lstsq(A, p - (0.0 if fitted else h_rows * step[a_rows]), rcond=None)[0]
+            origins = np.where(present[:, None], x[:3 * n_t].reshape(n_t, 3), np.nan)
         if fitted:
             step = np.zeros(3)
-            step[list(axes)] = x[3 * n_t:]
+            step[list(axes)] = x[3 * n_t:3 * n_t + len(axes)]
         else:
             step = _prior_step(base, origins)
     dev, can = np.full((n, 3), np.nan), np.zeros(n, dtype=bool)
@@ -230,7 +251,8 @@ def _grid(ev: Evidence, kept: np.ndarray) -> tuple[FloatArray, FloatArray, bool,
             if float(np.min(np.linalg.eigvalsh(0.5 * (M + M.T)))) > 1e-9:
                 dev[i, a_rows[r]] = np.linalg.solve(M, residual[r])
                 can[i] = True
-    return origins, step, fitted, dev, can, sum(k > 1 for k in levels)
+    stepped = sum(len({ev.slots[i][1] for i in fixing if ev.slots[i][0] == t}) > 1 for t in range(n_t))
+    return origins, step, fitted, dev, can, stepped
 
 
 def _headings(ev: Evidence, kept: np.ndarray) -> list[Check]:
@@ -278,8 +300,8 @@ def judge(ev: Evidence, kept: BoolArray) -> Judgement:
     origins, step, step_fitted, dev, can, n_stepped = _grid(ev, np.flatnonzero(kept))
     checks: list[Check] = []
     off, by = np.full(n, np.nan), [""] * n
-    for i in np.flatnonzero(can):
-        d = float(np.linalg.norm(np.nan_to_num(dev[i]))) * 1e3
+    for i in np.flatnonzero(can):  # an above pose by its horizontal place only (its height is the approach's)
+        d = float(np.linalg.norm(np.nan_to_num(dev[i] if is_on[i] else dev[i, :2]))) * 1e3
         limit = CONTACT_FLAG_MM if is_on[i] else ABOVE_FLAG_LINE_MM
         checks.append(Check("point" if is_on[i] else "above", int(i), d, d / limit))
         off[i], by[i] = d, BY_POINTS
@@ -308,6 +330,8 @@ def judge(ev: Evidence, kept: BoolArray) -> Judgement:
     expected, under = _expected(ev, origins, step, places, kept)
     for i in np.flatnonzero(kept & ~is_on):
         checks += _above_checks(ev, int(i), under[i], bool(can[i]))
+    checks += _approach_checks(ev, [int(i) for i in np.flatnonzero(kept & ~is_on) if not np.isnan(under[i, 0])],
+                               under)
     checks += _headings(ev, np.flatnonzero(kept))
     for i in np.flatnonzero(~kept):
         off[i] = float(np.linalg.norm(ev.m.p_world[i] - expected[i])) * 1e3
@@ -346,7 +370,23 @@ def _above_checks(ev: Evidence, i: int, contact: FloatArray, checked: bool) -> l
     height = (1.0 + (ABOVE_MIN_MM - over) / ABOVE_MIN_MM if over < ABOVE_MIN_MM else
               max(ABOVE_MIN_MM / over, over / (MAX_APPROACH_M * 1e3)))
     out = [] if checked else [Check("above", i, line, line / ABOVE_FLAG_LINE_MM)]
-    return [*out, Check("approach", i, over, height)]
+    return [*out, Check("over", i, over, height)]
+
+
+def _approach_checks(ev: Evidence, above: list[int], under: FloatArray) -> list[Check]:
+    """The above poses share one approach: each one's height over its contact against the others' median, over
+    ``max(8 mm, 5 x the others' spread)`` (hand-recorded tables put them anywhere over the stacks: their spread is
+    large, and so is the limit)."""
+    over = np.array([ev.m.p_world[i, 2] - under[i, 2] for i in above]) * 1e3
+    out = []
+    for j, i in enumerate(above):
+        others = np.delete(over, j)
+        if len(others):
+            mid = float(np.median(others))
+            spread = float(np.median(np.abs(others - mid)))
+            d = abs(float(over[j]) - mid)
+            out.append(Check("approach", i, d, d / max(CONTACT_FLAG_MM, HEADING_SIGMAS * spread)))
+    return out
 
 
 def decide(ev: Evidence, candidates: BoolArray) -> Consensus:

@@ -26,6 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
+from ur3hanoi.robot.ik import wrap_angle
 from ur3hanoi.robot.model import Ur3Model
 from ur3hanoi.station.grid import R_world_tcp_down
 from ur3hanoi.tables import Slot
@@ -61,10 +62,20 @@ class JointTypo:
     residual_deg: float
     explains: bool
 
+    @property
+    def sign(self) -> bool:
+        """True when the value that fits is the recorded one negated (a minus sign typed or lost), whole turns
+        aside."""
+        return abs(self.recorded) > math.radians(5.0) and abs(float(wrap_angle(self.recorded + self.predicted))) < max(
+            math.radians(1.0), 0.05 * abs(self.recorded))
+
     def describe(self) -> str:
-        """``"a typo in joint 2 (shoulder): recorded -45.0 deg (-0.785 rad), the grid predicts -55.0 deg ..."``."""
-        return (f"a typo in joint {self.joint + 1} ({JOINT_LABELS[self.joint]}): recorded {angle_text(self.recorded)}, "
-                f"the grid predicts {angle_text(self.predicted)}")
+        """``"a typo in joint 2 (shoulder): recorded -45.0 deg (-0.785 rad), the grid predicts -55.0 deg ..."``
+        (``"a sign typo in joint 2 ..."`` when :attr:`sign`)."""
+        kind = "a sign typo" if self.sign else "a typo"
+        predicted = -self.recorded if self.sign else self.predicted
+        return (f"{kind} in joint {self.joint + 1} ({JOINT_LABELS[self.joint]}): recorded {angle_text(self.recorded)}, "
+                f"the grid predicts {angle_text(predicted)}")
 
 
 def _errors(robot: Ur3Model, T_wb: pin.SE3, q: FloatArray, target: pin.SE3) -> tuple[float, float]:

@@ -37,7 +37,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.calibrate.consensus import Consensus, Evidence, decide, judge
+from ur3hanoi.calibrate.consensus import Consensus, judge
 from ur3hanoi.calibrate.explain import diagnose
 from ur3hanoi.calibrate.grid_fit import (
     BoolArray,
@@ -45,72 +45,19 @@ from ur3hanoi.calibrate.grid_fit import (
     GridSolution,
     Measured,
     choose_model,
-    measure,
 )
-from ur3hanoi.calibrate.limits import MAX_APPROACH_M
+from ur3hanoi.calibrate.limits import ABOVE_FLAG_LINE_MM, CONTACT_FLAG_MM, MAX_APPROACH_M
+from ur3hanoi.calibrate.prepare import MAX_TILT_DEG, Prepared, fail, prepare, underdetermined
 from ur3hanoi.calibrate.result import CalibrationFit, Suspect
 from ur3hanoi.calibrate.robust import RobustFit, robust_fit
 from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
-from ur3hanoi.calibrate.verdict import named_text, refusal, unexplained, where_text
-from ur3hanoi.errors import CalibrationError, TaughtPointsError, printable
+from ur3hanoi.calibrate.verdict import named_text, refusal, slot_text, unexplained, where_text
+from ur3hanoi.errors import CalibrationError, printable
 from ur3hanoi.robot.ik import wrap_angle
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import ABOVE, ON
 from ur3hanoi.tables import Slot
-
-MAX_TILT_DEG = 10.0  # [deg] a taught pose's tool must point down within this to be used (tables use exactly down)
-
-
-def _fail(source: str, msg: str) -> TaughtPointsError:
-    return TaughtPointsError(f"{printable(source)}: {msg}", source=source)
-
-
-# --------------------------------------------------------------------------------------------------- checks
-
-
-def _off_grid(base: Station, p: TaughtPoint) -> bool:
-    return not (0 <= p.tower < base.n_towers and 0 <= p.height < base.n_heights)
-
-
-def _hard_problems(base: Station, points: Sequence[TaughtPoint], m: Measured) -> list[str]:
-    """Per point, why it cannot take part in the fit ("" if it can)."""
-    out = []
-    for i, p in enumerate(points):
-        if not 0 <= p.tower < base.n_towers:
-            out.append(f"tower {p.tower + 1} is outside the base calibration's grid (towers 1..{base.n_towers} in "
-                       f"{printable(base.source)})")
-        elif not 0 <= p.height < base.n_heights:
-            out.append(f"height {p.height + 1} is outside the base calibration's grid (heights 1..{base.n_heights} "
-                       f"in {printable(base.source)})")
-        elif not base.limits.within_position(np.asarray(p.q, dtype=float)):
-            out.append(f"joint angles {np.round(np.degrees(p.q), 3).tolist()} deg are outside the joint limits of "
-                       f"{printable(base.source)}")
-        elif m.tilt_deg[i] > MAX_TILT_DEG:
-            out.append(f"the tool is tilted {m.tilt_deg[i]:.2f} deg from pointing down (more than "
-                       f"{MAX_TILT_DEG:g} deg: left out of the fit)")
-        else:
-            out.append("")
-    return out
-
-
-def _underdetermined(where: str, base: Station, points: Sequence[TaughtPoint], candidates: BoolArray,
-                     hard: Sequence[str]) -> TaughtPointsError:
-    """The "too little left to fit" error: what the grid needs, what is missing, what was left out."""
-    usable_on = {p.tower for i, p in enumerate(points) if candidates[i] and p.k == ON}
-    lacking = [t + 1 for t in range(base.n_towers) if t not in usable_on]
-    need = ("too little left to fit the grid: it needs a usable contact ('on') pose on every tower "
-            f"({base.n_towers} towers), and above poses count only on towers that also have one")
-    if lacking:
-        need += f"; tower(s) {', '.join(map(str, lacking))} have none"
-    left_out = [f"{p.label}: {hard[i]}" for i, p in enumerate(points) if hard[i]]
-    if left_out:
-        more = f" and {len(left_out) - 2} more" if len(left_out) > 2 else ""
-        need += f" (left out: {'; '.join(left_out[:2])}{more})"
-    if sum("tilted" in h for h in hard) > len(points) // 2:
-        need += f"; most poses are tilted: is the tool offset of {printable(base.source)} right?"
-    return _fail(where, need)
-
 
 # ------------------------------------------------------------------------------------------------- fitting
 
@@ -245,29 +192,37 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
     else:
         points, where, missing, shape = tuple(taught), "<memory>", (), None
     if not points:
-        raise _fail(where, "no taught points")
+        raise fail(where, "no taught points")
     if shape is not None and shape != (base.n_towers, base.n_heights):
-        raise _fail(where, f"the table has {shape[0]} towers x {shape[1]} heights, the base calibration "
+        raise fail(where, f"the table has {shape[0]} towers x {shape[1]} heights, the base calibration "
                            f"{printable(base.source)} {base.n_towers} x {base.n_heights}: use a base with the table's "
                            "grid")
 
-    prep = _prepare(base, points, accept)
+    prep = prepare(base, points, accept)
     slots = [(p.tower, p.height, p.k) for p in points]
     candidates = prep.candidates.copy()
     model = choose_model(base, [s for s, c in zip(slots, candidates, strict=True) if c])
     if model is None:
-        raise _underdetermined(where, base, points, candidates, prep.hard)
+        raise underdetermined(where, base, points, candidates, prep.hard)
     fit = robust_fit(base, model, prep.safe_slots, prep.m, candidates, tol_mm, tol_deg)
     c = prep.consensus
     named = {i: named_text(prep.evidence, c, i, points) for i in c.wrong}
     refused = c.kind == "undecided" or (c.kind == "named" and c.alone)
     problem = refusal(prep.evidence, c, points) if refused else ""
     heads = {i: where_text(prep.evidence, c, i) for i in c.wrong} if refused else {}
+    agreeing = candidates & ~np.isin(np.arange(len(points)), c.wrong if c.kind == "named" else ())
     if c.kind == "named" and not c.alone and fit.used[c.wrong[0]]:
-        candidates[c.wrong[0]] = False  # left out from the start: it never drags the fit
+        candidates = agreeing  # left out from the start: it never drags the fit
         model = choose_model(base, [s for s, k in zip(slots, candidates, strict=True) if k])
         assert model is not None  # its tower has another contact
         fit = robust_fit(base, model, prep.safe_slots, prep.m, candidates, tol_mm, tol_deg)
+    if c.kind in ("agree", "named") and not refused and _bends(fit, prep, agreeing):
+        # The finer pruning left out points that agree with the rest, and the grid moved more than the
+        # always-flagged distance from them: they agree, so they all stay.
+        candidates = agreeing
+        model = choose_model(base, [s for s, k in zip(slots, candidates, strict=True) if k])
+        assert model is not None
+        fit = robust_fit(base, model, prep.safe_slots, prep.m, candidates, tol_mm, tol_deg, prune=False)
     station, invalid = _station(base, model, fit.solution, fit.yaw, source)
     if name is not None:
         station = replace(station, name=name)
@@ -276,46 +231,7 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
     return _with_consensus(_calibration_fit(ctx, station, model, candidates, missing, problem or invalid), prep, c)
 
 
-@dataclass(frozen=True)
-class _Prepared:
-    """The points measured, those that cannot take part (``hard``, ``shared``), and the consensus on the rest."""
-
-    m: Measured
-    hard: tuple[str, ...]
-    shared: BoolArray
-    candidates: BoolArray
-    off_grid: BoolArray
-    safe_slots: list[Slot]
-    evidence: Evidence
-    consensus: Consensus
-
-
-def _prepare(base: Station, points: Sequence[TaughtPoint], accept: Collection[tuple[int, int]], label: str = ""
-             ) -> _Prepared:
-    m = measure(base, [p.q for p in points])
-    hard = tuple(_hard_problems(base, points, m))
-    shared = np.array([bool(p.shared) and not hard[i] for i, p in enumerate(points)])
-    candidates = np.array([not hard[i] and not shared[i] for i in range(len(points))])
-    # Points outside the grid take no part; they get placeholder slots (never used) so arrays stay aligned.
-    off_grid = np.array([_off_grid(base, p) for p in points])
-    safe_slots: list[Slot] = [(0, 0, ON) if off_grid[i] else (p.tower, p.height, p.k) for i, p in enumerate(points)]
-    accepted = np.array([p.k == ON and (p.tower, p.height) in accept for p in points]) & candidates
-    ev = Evidence(base=base, slots=tuple(safe_slots), m=m, accepted=accepted, label=label)
-    return _Prepared(m=m, hard=hard, shared=shared, candidates=candidates, off_grid=off_grid, safe_slots=safe_slots,
-                     evidence=ev, consensus=decide(ev, candidates))
-
-
-def taught_consensus(base: Station, taught: TaughtPoints | Sequence[TaughtPoint],
-                     accept: Collection[tuple[int, int]] = (), base_label: str = "") -> tuple[Consensus, Evidence]:
-    """The consensus on taught points (which one is wrong, each point's distance from where the others put it),
-    also when they do not determine the grid yet (teach's check after each record); messages name the base
-    ``base_label`` (default: its source)."""
-    points = taught.points if isinstance(taught, TaughtPoints) else tuple(taught)
-    prep = _prepare(base, points, accept, base_label)
-    return prep.consensus, prep.evidence
-
-
-def _with_consensus(fit: CalibrationFit, prep: _Prepared, c: Consensus) -> CalibrationFit:
+def _with_consensus(fit: CalibrationFit, prep: Prepared, c: Consensus) -> CalibrationFit:
     """The fit with what the consensus said: each point's distance from where the others put it, the points taken
     on the student's word, and, when no single point explains a disagreement the robust fit left, why."""
     kept = prep.candidates & ~np.isin(np.arange(len(fit.points)), c.wrong)
@@ -375,7 +291,7 @@ def _calibration_fit(ctx: _Context, station: Station, model: GridModel, candidat
         for i in order)
 
     if not problem:
-        problem = _soundness(fit, candidates, dev_mm)
+        problem = _soundness(fit, candidates, dev_mm, points)
     warnings = [f"{s.label} [{s.field}]: {s.reason}" for s in suspects]
     if problem:
         warnings.append(f"the fit is not sound: {problem}")
@@ -390,7 +306,18 @@ def _calibration_fit(ctx: _Context, station: Station, model: GridModel, candidat
     )
 
 
-def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray) -> str:
+def _bends(fit: RobustFit, prep: Prepared, candidates: BoolArray) -> bool:
+    """Whether the fit puts a candidate it left out farther from its slot than the always-flagged distance (an
+    above pose: off its tower's line)."""
+    d = prep.m.p_world - fit.solution.points(prep.safe_slots)
+    for i in np.flatnonzero(candidates & ~fit.used):
+        on = prep.safe_slots[i][2] == ON
+        if float(np.linalg.norm(d[i] if on else d[i, :2])) * 1e3 > (CONTACT_FLAG_MM if on else ABOVE_FLAG_LINE_MM):
+            return True
+    return False
+
+
+def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray, points: Sequence[TaughtPoint]) -> str:
     """Why the remaining fit cannot be trusted ("" if it can)."""
     n = int(candidates.sum())
     left_out = int((candidates & ~fit.used).sum())
@@ -398,10 +325,15 @@ def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray) -> str
     if left_out >= max(1, (n - 1) // 2) and over.any():
         return (f"{left_out} of {n} points left out and more still disagree with the grid: check the base "
                 "calibration's robot base and tool, and the tower/height labels")
-    if over.any():
-        return (f"{int(over.sum())} point(s) the fit cannot do without are more than {fit.thresholds.mm:.1f} mm off "
-                "the grid: re-record them or add points")
+    stuck = over & ~fit.removable  # the others do not determine the grid without them (pruning drops the others)
+    if stuck.any():
+        worst = sorted(np.flatnonzero(stuck), key=lambda i: -dev_mm[i])
+        named = [f"{slot_text(points[i])} ({dev_mm[i]:.1f} mm)" for i in worst[:3]]
+        more = f" and {len(worst) - 3} more" if len(worst) > 3 else ""
+        return (f"{', '.join(named)}{more}, which the fit cannot do without, {'is' if len(worst) == 1 else 'are'} "
+                f"more than {fit.thresholds.mm:.1f} mm off the grid: re-record {'it' if len(worst) == 1 else 'them'} "
+                "or add points")
     return ""
 
 
-__all__ = ["MAX_TILT_DEG", "fit_station", "taught_consensus"]
+__all__ = ["fit_station"]

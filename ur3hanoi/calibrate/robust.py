@@ -289,16 +289,21 @@ class _Lts:
 
 def robust_fit(base: Station, model: GridModel, slots: Sequence[Slot], m: Measured, candidates: BoolArray,
                tol_mm: float | None = None, tol_deg: float | None = None, angle_deg: FloatArray | None = None,
-               mm_range: tuple[float, float] | None = None) -> RobustFit:
+               mm_range: tuple[float, float] | None = None, prune: bool = True) -> RobustFit:
     """Fit ``model`` to the ``candidates`` among the points measured at ``slots``, leaving out gross errors
     (see the module docstring).
 
     ``candidates`` must determine ``model``. ``tol_mm`` / ``tol_deg`` replace the derived thresholds.
     ``angle_deg`` (N,) replaces the orientation error judged with each point (default: its angle from the grid
     pose, heading included); zeros judge positions only (the audit checks the suction axis on its own).
-    ``mm_range`` (floor, ceiling) [mm] bounds the derived position threshold instead of the floor alone.
+    ``mm_range`` (floor, ceiling) [mm] bounds the derived position threshold instead of the floor alone. With
+    ``prune`` False every candidate stays in the fit (the points are known to agree: they are only judged).
     """
     cand = np.flatnonzero(candidates)
+    if not prune:
+        every = np.zeros(len(slots), dtype=bool)
+        every[cand] = True
+        return _evaluate(base, model, slots, m, every, candidates, tol_mm, tol_deg, None, angle_deg, mm_range)
     starts = _Lts(base, model, slots, m.p_world).starts(cand) if 3 * len(cand) > model.n_unknowns else [cand]
 
     def mask(idx: np.ndarray) -> BoolArray:

@@ -84,9 +84,9 @@ def _typo(ev: Evidence, p: TaughtPoint, i: int, target: np.ndarray, axis: np.nda
 def _typo_named(typo: JointTypo) -> Named:
     j, rec, exp = typo.joint, typo.recorded, typo.predicted
     name = f"joint {j + 1} ({JOINT_LABELS[j]})"
-    if abs(rec) > math.radians(5.0) and abs(rec + exp) < max(math.radians(1.0), 0.05 * abs(rec)):
+    if typo.sign:
         return Named(f"likely a sign typo in {name}: recorded {math.degrees(rec):.1f} deg, the others put it at "
-                     f"{math.degrees(exp):.1f} deg", f"correct the sign of {name} or re-record it", True)
+                     f"{-math.degrees(rec):.1f} deg", f"correct the sign of {name} or re-record it", True)
     return Named(f"likely a typo in {name}: recorded {angle_text(rec)}, the others put it at {angle_text(exp)} "
                  f"({math.degrees(exp - rec):+.1f} deg)", f"correct {name} or re-record it", True)
 
@@ -194,6 +194,8 @@ def _check_text(ev: Evidence, j: Judgement, what: str, index: int, value: float,
         return f"the suction axis of {slot_text(points[index])} is {value:.1f} deg from the others'"
     if what == "above":
         return f"{slot_text(points[index])} is {value:.1f} mm off its tower's vertical line"
+    if what == "approach":
+        return f"{slot_text(points[index])} stands {value:.1f} mm higher or lower over its contact than the others"
     return f"{slot_text(points[index])} stands {value:.1f} mm over its contact"
 
 

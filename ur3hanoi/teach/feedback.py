@@ -1,7 +1,7 @@
 """What teach says after each record from the third point on: every point's distance from where the others put it,
 and the point that is wrong, so a bad pose is named the moment it is taught.
 
-The judgement is the calibration's own (:func:`ur3hanoi.calibrate.fit.taught_consensus`, exactly what ``calibrate``
+The judgement is the calibration's own (:func:`ur3hanoi.calibrate.prepare.taught_consensus`, what ``calibrate``
 and ``f`` decide): a point that shares its tower with another is judged by the other points, a tower taught once
 by the base calibration's layout moved and turned onto the other towers, each against the audit's always-flagged
 distance (:data:`ur3hanoi.calibrate.limits.CONTACT_FLAG_MM`, 8 mm); which point is wrong is the one whose removal
@@ -19,8 +19,8 @@ from dataclasses import dataclass
 from ur3hanoi.calibrate import CalibrationFit, fit_station
 from ur3hanoi.calibrate.consensus import BY_LAYOUT as LAYOUT
 from ur3hanoi.calibrate.consensus import BY_POINTS as POINTS
-from ur3hanoi.calibrate.fit import taught_consensus
 from ur3hanoi.calibrate.limits import CONTACT_FLAG_MM
+from ur3hanoi.calibrate.prepare import taught_consensus
 from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
 from ur3hanoi.calibrate.verdict import named_text, refusal, where_text
 from ur3hanoi.errors import TaughtPointsError, printable
