@@ -21,9 +21,10 @@ Module map:
   them).
 - :mod:`~ur3hanoi.calibrate.layout`: the base calibration's tower layout moved and turned as a whole, where it puts
   a tower the points alone cannot place.
+- :mod:`~ur3hanoi.calibrate.evidence`: a set of points judged on all the evidence (positions, the tool's
+  orientation, the step and block size, the approach, the base's layout moved and turned as a whole).
 - :mod:`~ur3hanoi.calibrate.consensus`: which point is grossly wrong, by what explains the most: the one whose
-  removal leaves the others consistent with each other, the block size, the base's layout and the tool's
-  orientation; or that the points cannot tell.
+  removal leaves the others consistent; or that the points cannot tell.
 - :mod:`~ur3hanoi.calibrate.robust`: sequential leave-one-out deletion of gross errors, with suspect thresholds
   from the data's robust scatter (``max(3 mm, 5 sigma)``, ``max(2 deg, 5 sigma)``).
 - :mod:`~ur3hanoi.calibrate.explain`: why a pose is off (a typo in one joint, swapped or copied entries, a pose

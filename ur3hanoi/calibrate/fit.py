@@ -37,7 +37,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.calibrate.consensus import Consensus, judge
+from ur3hanoi.calibrate.consensus import Consensus
+from ur3hanoi.calibrate.evidence import judge
 from ur3hanoi.calibrate.explain import diagnose
 from ur3hanoi.calibrate.grid_fit import (
     BoolArray,

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ur3hanoi.calibrate.consensus import Consensus, Evidence, decide
+from ur3hanoi.calibrate.consensus import Consensus, decide
+from ur3hanoi.calibrate.evidence import Evidence
 from ur3hanoi.calibrate.grid_fit import BoolArray, Measured, measure
 from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
 from ur3hanoi.errors import TaughtPointsError, printable

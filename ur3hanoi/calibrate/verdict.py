@@ -24,7 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ur3hanoi.calibrate.consensus import BY_LAYOUT, HEADING_DEG, HEADING_SIGMAS, Consensus, Evidence, Judgement
+from ur3hanoi.calibrate.consensus import Consensus
+from ur3hanoi.calibrate.evidence import BY_LAYOUT, HEADING_DEG, SPREAD_SIGMAS, Evidence, Judgement
 from ur3hanoi.calibrate.explain import JOINT_LABELS, TYPO_SHARE, JointTypo, angle_text, joint_typo_point
 from ur3hanoi.calibrate.limits import CONTACT_FLAG_MM, CONTACT_OK_MM, TILT_FLAG_DEG, TILT_OK_DEG, table_axis
 from ur3hanoi.calibrate.taught import TaughtPoint
@@ -99,7 +100,7 @@ def _heading(ev: Evidence, chosen: Judgement, i: int) -> tuple[float, float]:
     mean = math.atan2(float(np.mean(np.sin(h))), float(np.mean(np.cos(h))))
     spread = float(np.median(np.abs(np.degrees(wrap_angle(h - mean)))))
     off = abs(math.degrees(float(wrap_angle(ev.m.heading[i] - mean))))
-    return off, max(HEADING_DEG, HEADING_SIGMAS * spread)
+    return off, max(HEADING_DEG, SPREAD_SIGMAS * spread)
 
 
 def diagnose_named(ev: Evidence, chosen: Judgement, i: int, points: Points) -> Named:

@@ -17,8 +17,8 @@ from collections.abc import Collection
 from dataclasses import dataclass
 
 from ur3hanoi.calibrate import CalibrationFit, fit_station
-from ur3hanoi.calibrate.consensus import BY_LAYOUT as LAYOUT
-from ur3hanoi.calibrate.consensus import BY_POINTS as POINTS
+from ur3hanoi.calibrate.evidence import BY_LAYOUT as LAYOUT
+from ur3hanoi.calibrate.evidence import BY_POINTS as POINTS
 from ur3hanoi.calibrate.limits import CONTACT_FLAG_MM
 from ur3hanoi.calibrate.prepare import taught_consensus
 from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
@@ -127,8 +127,16 @@ def feedback(base: Station, taught: TaughtPoints, base_label: str, accept: Colle
                     layout_shift_mm=(sx, sy, sz))
 
 
+def finish_problem(base: Station, taught: TaughtPoints, accept: Collection[tuple[int, int]] = ()) -> str:
+    """Why the calibration cannot be written from the points taught ("" when it can): what ``f`` checks first."""
+    try:
+        return fit_station(base, taught, accept=accept).problem
+    except TaughtPointsError as exc:
+        return str(exc).split(": ", 1)[-1]
+
+
 def _label(p: TaughtPoint) -> str:
     return pose_label(p.tower, p.height, p.k).removesuffix(" on")
 
 
-__all__ = ["BY_LAYOUT", "BY_POINTS", "FIRST_FEEDBACK", "Feedback", "PointCheck", "feedback"]
+__all__ = ["BY_LAYOUT", "BY_POINTS", "FIRST_FEEDBACK", "Feedback", "PointCheck", "feedback", "finish_problem"]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 
+from ur3hanoi.teach.feedback import finish_problem
 from ur3hanoi.teach.jog import JOG_ACCEL_RAD_S2, JOG_SPEED_RAD_S, JOG_STEPS_MM
 from ur3hanoi.teach.session import Teacher
 from ur3hanoi.teach.stillness import STILL_TOL_DEG, STILL_WINDOW_S
@@ -59,7 +60,7 @@ def _finish_problem(teacher: Teacher) -> str:
     if lacking:
         return (f"cannot finish yet: tower(s) {', '.join(lacking)} have no contact pose (the fit needs one on every "
                 "tower); record them, or Ctrl-C to stop here (the points are saved)")
-    problem = teacher.finish_problem()
+    problem = finish_problem(teacher.base, teacher.taught.taught(), teacher.accept)
     if problem:
         return f"cannot finish yet: {problem} (u undoes the last point; Ctrl-C stops here, the points are saved)"
     return ""

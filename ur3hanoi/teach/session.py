@@ -22,8 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.calibrate import fit_station
-from ur3hanoi.errors import TaughtPointsError, printable
+from ur3hanoi.errors import printable
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import ON, contact_point_world
 from ur3hanoi.teach.advice import Advice, next_pose
@@ -170,13 +169,6 @@ class Teacher:
         self._advise()
         lines.append(self.next_line())
         return True, lines
-
-    def finish_problem(self) -> str:
-        """Why the calibration cannot be written from the points taught ("" when it can)."""
-        try:
-            return fit_station(self.base, self.taught.taught(), accept=self.accept).problem
-        except TaughtPointsError as exc:
-            return str(exc).split(": ", 1)[-1]
 
     def undo(self) -> list[str]:
         self.taught, said = self.taught.without_last()
