@@ -13,7 +13,8 @@ Each case's outcome (:func:`outcome`) is one of :data:`ALLOWED`:
 
 - ``named``: written, the wrong point named first and left out, every contact of every tower within
   :data:`TOWER_MM` (3 mm) of the truth;
-- ``refused``: nothing written (exit 2), the message names the wrong point first;
+- ``refused``: nothing written (exit 2), the report names the wrong point first (and the error line names it:
+  tests/calibrate/test_verdict.py);
 - ``undecided``: nothing written, the message names the wrong point among the ones the points cannot tell apart;
 - ``kept``: written with the wrong point in, every tower within the always-flagged 8 mm (plus the hidden towers'
   own offsets) of the truth: an error the evidence cannot see (an above pose's height is the approach itself; a
@@ -172,13 +173,13 @@ def outcome(case: Case) -> tuple[str, str]:
         return ("refused" if case.label.split(" [")[0] in str(exc) else "refused, unnamed"), str(exc)
     said = fit.problem or (fit.warnings[0] if fit.warnings else "")
     first = bool(fit.suspects) and fit.suspects[0].index == case.wrong
-    if not fit.sound:
-        named = getattr(fit, "named", ())
-        if first and case.label in fit.problem:
+    if not fit.sound:  # the report names the suspects worst first, then the one error line says why
+        if first:
             return "refused", said
-        if case.wrong in named and case.label in fit.problem:
+        if case.wrong in getattr(fit, "named", ()) and case.label in fit.problem:
             return "undecided", said
-        return "refused, unnamed" if case.label not in fit.problem else "refused, named not first", said
+        named = any(s.index == case.wrong for s in fit.suspects)
+        return "refused, named not first" if named else "refused, unnamed", said
     worst = tower_error_mm(fit.station, case.truth.truth)
     if not fit.used[case.wrong]:
         if not first:

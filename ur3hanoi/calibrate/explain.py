@@ -36,6 +36,8 @@ JOINT_LABELS: tuple[str, ...] = ("base", "shoulder", "elbow", "wrist 1", "wrist 
 
 MIN_TYPO_DEG = 0.5
 """[deg] a single-joint change smaller than this is noise, not a typo."""
+MIN_SIGN_DEG = 10.0
+"""[deg] a joint value at least this far from 0 and 180 deg, negated, is called a sign typo."""
 
 
 def angle_text(rad: float) -> str:
@@ -65,9 +67,11 @@ class JointTypo:
     @property
     def sign(self) -> bool:
         """True when the value that fits is the recorded one negated (a minus sign typed or lost), whole turns
-        aside."""
-        return abs(self.recorded) > math.radians(5.0) and abs(float(wrap_angle(self.recorded + self.predicted))) < max(
-            math.radians(1.0), 0.05 * abs(self.recorded))
+        aside, within 1 deg, and negating it changes it by at least twice :data:`MIN_SIGN_DEG` (a value near 0 or
+        180 deg negated is as much an ordinary typo)."""
+        change = abs(float(wrap_angle(2.0 * self.recorded)))
+        return change >= math.radians(2.0 * MIN_SIGN_DEG) and abs(float(wrap_angle(
+            self.recorded + self.predicted))) < math.radians(1.0)
 
     def describe(self) -> str:
         """``"a typo in joint 2 (shoulder): recorded -45.0 deg (-0.785 rad), the grid predicts -55.0 deg ..."``
@@ -337,6 +341,7 @@ def diagnose_contacts(robot: Ur3Model, T_world_base: pin.SE3, slots: Sequence[Sl
 
 __all__ = [
     "JOINT_LABELS",
+    "MIN_SIGN_DEG",
     "MIN_TYPO_DEG",
     "TYPO_SHARE",
     "JointTypo",

@@ -235,11 +235,13 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
 def _with_consensus(fit: CalibrationFit, prep: Prepared, c: Consensus) -> CalibrationFit:
     """The fit with what the consensus said: each point's distance from where the others put it, the points taken
     on the student's word, and, when no single point explains a disagreement the robust fit left, why."""
-    kept = prep.candidates & ~np.isin(np.arange(len(fit.points)), c.wrong)
-    word = replace(prep.evidence, accepted=np.zeros(len(fit.points), dtype=bool))
-    layout = {ch.index: ch.value for ch in judge(word, kept).checks if ch.what == "layout"}
-    accepted = tuple((int(i), float(layout.get(fit.points[i].tower, math.nan)))
-                     for i in np.flatnonzero(prep.evidence.accepted))
+    accepted: tuple[tuple[int, float], ...] = ()
+    if prep.evidence.accepted.any():  # how far the layout would have put their towers
+        kept = prep.candidates & ~np.isin(np.arange(len(fit.points)), c.wrong)
+        word = replace(prep.evidence, accepted=np.zeros(len(fit.points), dtype=bool))
+        layout = {ch.index: ch.value for ch in judge(word, kept).checks if ch.what == "layout"}
+        accepted = tuple((int(i), float(layout.get(fit.points[i].tower, math.nan)))
+                         for i in np.flatnonzero(prep.evidence.accepted))
     out = replace(fit, consensus=c.kind, named=c.wrong, off_mm=c.chosen.off_mm, judged_by=c.chosen.by,
                   accepted=accepted)
     if c.kind == "unexplained" and fit.sound:
