@@ -125,3 +125,18 @@ def test_a_point_vouched_for_is_never_left_out_and_its_tower_not_judged(hidden: 
     assert said.kind == "named" and said.wrong == (1,) and said.alone
     vouched = consensus(base, FIRST, m, np.ones(3, dtype=bool), accepted=np.array([False, True, False]))
     assert vouched.kind == "agree" and not any(c.what == "layout" and c.index == 1 for c in vouched.whole.checks)
+
+
+def test_a_tower_alone_fixing_the_step_is_checked_by_the_block_size() -> None:
+    """Tower 1 taught at heights 1 and 3 (the others once): its height 1 recorded with height 2's pose halves the
+    step. Nothing but the base's block size says so, and the pose that leaves tower 1 on the table is the one."""
+    base = load_station("lab_real")
+    q = generate_table(base).q
+    slots = [(0, 2, 0), (1, 0, 0), (2, 0, 0), (0, 0, 0)]
+    qs = [q[s] for s in slots]
+    qs[3] = q[0, 1, 0]
+    c = consensus(base, slots, measure(base, qs), np.ones(4, dtype=bool))
+    assert not any(ch.what == "point" for ch in c.whole.checks)  # the points cannot check each other
+    step = [ch for ch in c.whole.checks if ch.what == "step"]
+    assert len(step) == 1 and step[0].over and step[0].value == pytest.approx(2 * 15.9, abs=0.1)
+    assert c.kind == "named" and c.wrong == (3,) and not c.alone
