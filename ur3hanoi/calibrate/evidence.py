@@ -6,7 +6,8 @@ The evidence, each with the audit's always-flagged limit (:mod:`ur3hanoi.calibra
 consistent when nothing is over its limit:
 
 - **positions**: a contact that the others check (its tower has another contact, or the step is fitted without it)
-  is within :data:`CONTACT_FLAG_MM` (8 mm) of where the grid fitted to the other contacts puts it;
+  is within :data:`CONTACT_FLAG_MM` (8 mm) of where the grid fitted to the other points puts it (an above pose:
+  its horizontal place, within :data:`ABOVE_FLAG_LINE_MM`, 10 mm: its height is the approach's);
 - **the height step and the block size**: when one tower alone fixes the step, the top level it gives is within
   8 mm of where the base's step (one block up; a flat base: its row step turned with the towers) puts it;
 - **the base's layout moved and turned as a whole**: a tower taught at one contact only stands within 8 mm of where
