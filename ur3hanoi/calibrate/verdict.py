@@ -136,7 +136,8 @@ def diagnose_named(ev: Evidence, chosen: Judgement, i: int, points: Points) -> N
     if off > limit:
         turned.append(f"the tool is turned {off:.0f} deg from the others' heading")
     how = f" ({'; '.join(turned)})" if turned else ""
-    return Named(f"no single joint explains it: the arm was not on the block{how}", "re-record it", bool(turned))
+    where = "on the block" if p.k == ON else "over its block at the others' approach height"
+    return Named(f"no single joint explains it: the arm was not {where}{how}", "re-record it", bool(turned))
 
 
 def _judgement(c: Consensus, i: int) -> Judgement:

@@ -256,7 +256,7 @@ def _finish(args: argparse.Namespace, base: Station, base_label: str, taught: Ta
     for line in accepted_lines(fit.points, fit.accepted, base_label):
         print(line)
     fb = feedback(base, points, base_label, accept)
-    worst = max((r.off_mm for r in fb.rows if not math.isnan(r.off_mm)), default=math.nan)
+    worst = max((r.off_mm for r in fb.rows if not math.isnan(r.off_mm) and fit.used[r.index]), default=math.nan)
     exact = ("an exact fit (one point per tower): each tower origin is where its taught pose put it, as accurate "
              "as that pose" if fit.dof == 0 else f"residual rms {fit.rms_mm:.2f} mm over {fit.n_used} points")
     print(f"wrote {shown(station_out)}: {exact}; every point within {worst:.1f} mm of where the others put it; "
