@@ -11,7 +11,9 @@ absolute path, so a name like ``-x.mp4`` is never an ffmpeg option) that replace
 is closed normally; frames go to a temporary folder moved into place on close. An error, or leaving the ``with``
 block by an exception, discards them: an existing video or folder stays as it was.
 
-Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo is imported.
+MuJoCo renders with the OpenGL platform it was imported with (``MUJOCO_GL``): the commands choose one that works
+before importing it (:func:`ur3hanoi.opengl.use_platform`: the display's, else EGL, else OSMesa); a script that
+renders without a display calls it first too, or sets ``MUJOCO_GL``.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import math
 import os
 import re
 import signal
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +34,7 @@ import numpy as np
 
 from ur3hanoi.errors import OutputError, SimulationError, Ur3HanoiError, printable, quote
 from ur3hanoi.io.atomic import PendingDir, PendingFile, check_output, check_output_dir
+from ur3hanoi.opengl import display_available, render_failed
 from ur3hanoi.sim.scene import slot_centers
 from ur3hanoi.station.calibration import Station
 
@@ -150,6 +154,20 @@ def _draw(renderer: mujoco.Renderer, data: mujoco.MjData, camera: mujoco.MjvCame
     return renderer.render()
 
 
+def _renderer(model: mujoco.MjModel, cam: CameraConfig) -> mujoco.Renderer:
+    """An offscreen renderer of the camera's size. Raises SimulationError (one line) when MuJoCo's OpenGL platform
+    cannot make a context; what its library says (GLFW's warnings) goes into that line, not onto the terminal."""
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        try:
+            return mujoco.Renderer(model, cam.height, cam.width)
+        except ValueError:  # a size the framebuffer does not hold: a bug here, not a missing OpenGL
+            raise
+        except Exception as exc:
+            reason = str(said[0].message) if said else f"{type(exc).__name__}: {exc}"
+    raise SimulationError(render_failed(" ".join(reason.split())))
+
+
 # A rendering worker process's state (set by _init_worker; one renderer per process).
 _WORKER: dict[str, Any] = {}
 
@@ -162,7 +180,7 @@ def _init_worker(parent: int, model: mujoco.MjModel, lookat: tuple[float, float,
     # One llvmpipe thread per process: the processes are the parallelism (read when the GL driver loads).
     os.environ.setdefault("LP_NUM_THREADS", "1")
     _WORKER["model"], _WORKER["data"] = model, mujoco.MjData(model)
-    _WORKER["renderer"] = mujoco.Renderer(model, cam.height, cam.width)
+    _WORKER["renderer"] = _renderer(model, cam)
     _WORKER["camera"], _WORKER["cam"] = _camera(lookat, cam), cam
 
 
@@ -181,8 +199,8 @@ class OffscreenRecorder:
     is the number written. With ``workers`` > 1 the run only records each frame's joint state, and
     :meth:`render_pending` (called by the context manager on success) renders them in that many processes
     (``spawn``, one software-GL thread each), in order, reporting ``progress(fraction, label)`` per frame, while
-    ffmpeg encodes in its own process. Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo
-    is imported. A video needs ``imageio-ffmpeg`` (its wheel ships ffmpeg) and an extension of
+    ffmpeg encodes in its own process. MuJoCo renders with the OpenGL platform it was imported with (see the
+    module docstring). A video needs ``imageio-ffmpeg`` (its wheel ships ffmpeg) and an extension of
     :data:`VIDEO_FORMATS`; PNG needs only Pillow. Use as a context manager (it closes the renderer and finishes the
     file, or :meth:`discard` s it when the block raises). The output is checked here (:mod:`ur3hanoi.io.atomic`)
     and written only on close.
@@ -234,13 +252,7 @@ class OffscreenRecorder:
         self.model, self.lookat = model, _lookat(station)
         self.workers, self.progress = max(1, int(workers)), progress
         self._states: list[tuple[float, Any]] = []  # (t, qpos) of the frames to render in parallel at close()
-        try:
-            self.renderer = mujoco.Renderer(model, cam.height, cam.width)
-        except ValueError:  # a size the framebuffer does not hold: a bug here, not a missing OpenGL
-            raise
-        except Exception as exc:  # no OpenGL context: the message says which backend failed
-            raise SimulationError(f"offscreen rendering is unavailable ({exc}); on a headless machine set "
-                                  "MUJOCO_GL=egl (libegl1) or MUJOCO_GL=osmesa (libosmesa6)") from None
+        self.renderer = _renderer(model, cam)
         self.camera = _free_camera(station, cam)
         self._pool: Any = None
         if self.workers > 1:
@@ -367,13 +379,6 @@ class OffscreenRecorder:
             raise
         finally:
             self.close()
-
-
-def display_available() -> str | None:
-    """None when an interactive viewer can open, else the reason it cannot."""
-    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        return "no display (DISPLAY and WAYLAND_DISPLAY are unset)"
-    return None
 
 
 class ViewerSink:
