@@ -4,7 +4,6 @@
 PY ?= python3
 VENV ?= .venv
 STAMP := $(VENV)/.installed
-export MUJOCO_GL ?= egl
 export NO_MKDOCS_2_WARNING ?= 1  # Material's end-of-life notice on every docs build
 
 .PHONY: solve test test-fast venv lint bench tables docs pictures clean lab

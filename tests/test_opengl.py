@@ -16,7 +16,7 @@ from tests.support.opengl_support import without_opengl
 from ur3hanoi.errors import SimulationError
 from ur3hanoi.opengl import EGL, GLFW, MUJOCO_GL, OSMESA, VERIFIED, Choice, choose, render_failed
 
-NO_DISPLAY = "no display (DISPLAY and WAYLAND_DISPLAY unset)"
+NO_DISPLAY = "no display (DISPLAY and WAYLAND_DISPLAY are unset)"
 
 
 def _headless(**extra: str) -> dict[str, str]:
@@ -124,7 +124,27 @@ def test_with_no_platform_the_error_names_each_one_tried_and_what_provides_it() 
     assert "\n" not in error
 
 
+_UNCHOSEN = """
+import mujoco
+from ur3hanoi.opengl import offscreen_renderer
+try:
+    offscreen_renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), 16, 16)
+except Exception as exc:
+    print(type(exc).__name__, exc)
+"""
+
+
+def test_a_script_that_imports_mujoco_before_choosing_gets_one_line_and_no_warning() -> None:
+    """MuJoCo imported with MUJOCO_GL unset and no display binds GLFW, which cannot work: the renderer's failure is
+    one line saying what to do, and GLFW's warnings go into it, not onto stderr."""
+    proc = subprocess.run([sys.executable, "-c", _UNCHOSEN], env=_headless(), capture_output=True, text=True,
+                          cwd=REPO, timeout=120, check=False)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    assert proc.stdout == ("SimulationError offscreen rendering is unavailable: X11: The DISPLAY environment variable "
+                           "is missing; MuJoCo was imported with MUJOCO_GL unset (GLFW, which needs a display): call "
+                           "ur3hanoi.opengl.use_platform() before importing MuJoCo, or set MUJOCO_GL\n")
+
+
 def test_a_renderer_that_fails_after_the_choice_says_which_setting_failed() -> None:
     assert render_failed("no context", {"MUJOCO_GL": "osmesa"}) == (
         "offscreen rendering with MUJOCO_GL='osmesa' failed: no context; OSMesa needs Debian package libosmesa6")
-    assert "call ur3hanoi.opengl.use_platform() before importing MuJoCo" in render_failed("no context", {})

@@ -22,12 +22,19 @@ importing anything of ``ur3hanoi.sim`` imports MuJoCo.
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from collections.abc import Mapping, MutableMapping
-from typing import NamedTuple
+from pathlib import Path
+from typing import TYPE_CHECKING, NamedTuple
 
 from ur3hanoi.errors import SimulationError, printable, quote
+
+if TYPE_CHECKING:
+    import warnings
+
+    import mujoco
 
 MUJOCO_GL = "MUJOCO_GL"
 """The environment variable MuJoCo reads when it is imported."""
@@ -79,47 +86,27 @@ def display_available(environ: Mapping[str, str] | None = None) -> str | None:
     return None
 
 
-# Run by `python -c` in the child: renders one frame with the MUJOCO_GL it was given; prints "ok", or the reason on
-# one line. Library warnings (GLFW's) are recorded, not shown: the first one is usually the reason.
-_PROBE = r"""
-import re, sys, warnings
-warnings.simplefilter("always")
-with warnings.catch_warnings(record=True) as said:
-    try:
-        import mujoco
-        model = mujoco.MjModel.from_xml_string("<mujoco/>")
-        renderer = mujoco.Renderer(model, 16, 16)
-        renderer.render()
-        renderer.close()
-    except BaseException as exc:
-        libraries = {"egl": "libEGL.so.1", "osmesa": "libOSMesa.so.8"}
-        reason = f"{type(exc).__name__}: {exc}"
-        name = sys.argv[1]
-        if name in libraries:
-            import ctypes
-            try:
-                ctypes.CDLL(libraries[name])
-            except OSError as missing:
-                reason = str(missing)
-        if said:
-            reason = re.sub(r"^\(\d+\) b?['\"](.*)['\"]$", r"\1", str(said[0].message))
-        print(" ".join(reason.split()))
-        sys.exit(1)
-print("ok")
-"""
+_GLFW_ERROR = re.compile(r"\((\d+)\) b?(['\"])(.*)\2")
+
+
+def _said(message: str) -> str:
+    """A library's message on one line; GLFW's ``(65550) b'X11: ...'`` as ``X11: ...``."""
+    message = " ".join(message.split())
+    glfw = _GLFW_ERROR.fullmatch(message)
+    return glfw.group(3) if glfw else message
 
 
 def probe(platform: str, environ: Mapping[str, str] | None = None, timeout_s: float = PROBE_TIMEOUT_S) -> str | None:
-    """Render one frame with ``MUJOCO_GL=platform`` in a child process: None if it works, else why not (one line).
-    Nothing the child or its libraries print reaches the terminal."""
-    from ur3hanoi.lifecycle import child_preexec
-
+    """Render one frame with ``MUJOCO_GL=platform`` in a child process (:func:`_probe_child`): None if it works,
+    else why not (one line). Nothing the child or its libraries print reaches the terminal."""
     env = {**(os.environ if environ is None else environ), MUJOCO_GL: platform}
     env.pop(VERIFIED, None)
-    try:
-        proc = subprocess.run([sys.executable, "-c", _PROBE, platform], env=env, stdin=subprocess.DEVNULL,
-                              capture_output=True, text=True, errors="replace", timeout=timeout_s,
-                              preexec_fn=child_preexec(), check=False)
+    here = str(Path(__file__).resolve().parents[1])  # this copy of ur3hanoi, whatever the child's path
+    code = f"import sys; sys.path.insert(0, {here!r}); from ur3hanoi.opengl import _probe_child; _probe_child()"
+    try:  # on any exception (a Ctrl-C), subprocess.run kills the child before raising
+        proc = subprocess.run([sys.executable, "-c", code, str(os.getpid()), platform], env=env,
+                              stdin=subprocess.DEVNULL, capture_output=True, text=True, errors="replace",
+                              timeout=timeout_s, check=False)
     except subprocess.TimeoutExpired:
         return f"no frame within {timeout_s:g} s"
     except OSError as exc:
@@ -130,7 +117,50 @@ def probe(platform: str, environ: Mapping[str, str] | None = None, timeout_s: fl
     if not said:  # it crashed: its last line on stderr, if any
         lines = proc.stderr.strip().splitlines()
         said = f"exit {proc.returncode}" + (f": {lines[-1]}" if lines else "")
-    return printable(said, 160)
+    return printable(_said(said), 160)
+
+
+_LIBRARIES = {"egl": "libEGL.so.1", "osmesa": "libOSMesa.so.8"}
+"""The library each headless platform loads first (Debian's names): when it does not load, that is the reason."""
+
+
+def _probe_child() -> None:
+    """A probe's child (``python -c``; argv: the parent's pid, the platform): renders one 16x16 frame with the
+    ``MUJOCO_GL`` it was given and prints ``ok``, or the reason on one line: GLFW's first error (a warning, kept
+    from the terminal), else why the platform's library does not load, else the exception. Dies with its parent."""
+    import warnings
+
+    from ur3hanoi.lifecycle import child_start
+
+    child_start(int(sys.argv[1]))
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        try:
+            import mujoco
+
+            renderer = mujoco.Renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), 16, 16)
+            renderer.render()
+            renderer.close()
+        except Exception as exc:
+            print(_why(exc, said, sys.argv[2]), flush=True)
+            sys.exit(1)
+    print("ok", flush=True)
+
+
+def _why(exc: Exception, said: list[warnings.WarningMessage], platform: str) -> str:
+    """Why rendering with ``platform`` failed with ``exc``, the library's warnings ``said`` on the way (one line)."""
+    glfw = [w for w in said if w.category.__name__ == "GLFWError"]
+    if glfw:
+        return _said(str(glfw[0].message))
+    library = _LIBRARIES.get(platform.strip().lower())
+    if library is not None:
+        import ctypes
+
+        try:
+            ctypes.CDLL(library)
+        except OSError as missing:
+            return _said(str(missing))
+    return _said(f"{type(exc).__name__}: {exc}")
 
 
 def _needs(name: str) -> str:
@@ -159,14 +189,15 @@ def choose(environ: Mapping[str, str] | None = None) -> Choice:
             return Choice(known[name], chosen=verified[1:] == ["chosen"])
         reason = probe(given, env)
         if reason is None:
-            return Choice(known.get(name, Platform(name, f"MUJOCO_GL={name}", "")), chosen=False)
+            return Choice(known.get(name, Platform(name, f"MuJoCo's {name!r} platform", "")), chosen=False)
         raise SimulationError(f"offscreen rendering cannot use {MUJOCO_GL}={quote(given)} (set in the environment): "
                               f"{reason}; {_needs(name)}; or unset {MUJOCO_GL} to let ur3hanoi choose")
     tried: list[str] = []
     passed_over: list[str] = []
     for platform in PLATFORMS:
-        if platform is GLFW and display_available(env) is not None:
-            tried.append(f"{platform.title}: no display (DISPLAY and WAYLAND_DISPLAY unset)")
+        no_display = display_available(env) if platform is GLFW else None
+        if no_display is not None:
+            tried.append(f"{platform.title}: {no_display}")
             passed_over.append("no display")
             continue
         reason = probe(platform.name, env)
@@ -215,5 +246,28 @@ def render_failed(reason: str, environ: Mapping[str, str] | None = None) -> str:
     return f"offscreen rendering with {MUJOCO_GL}={quote(given)} failed: {reason}; {_needs(given.strip().lower())}"
 
 
+def offscreen_renderer(model: mujoco.MjModel, height: int, width: int) -> mujoco.Renderer:
+    """``mujoco.Renderer(model, height, width)`` in this process, with the platform MuJoCo was imported with.
+
+    Raises:
+        SimulationError: the platform cannot make an OpenGL context (:func:`render_failed`); what its library says
+            (GLFW's warnings) goes into that one line, not onto the terminal.
+        ValueError: a size the model's offscreen framebuffer does not hold (a bug of the caller, not OpenGL).
+    """
+    import warnings
+
+    import mujoco
+
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        try:
+            return mujoco.Renderer(model, height, width)
+        except ValueError:
+            raise
+        except Exception as exc:
+            reason = _why(exc, said, os.environ.get(MUJOCO_GL, GLFW.name))
+    raise SimulationError(render_failed(reason))
+
+
 __all__ = ["EGL", "GLFW", "MUJOCO_GL", "OSMESA", "PLATFORMS", "PROBE_TIMEOUT_S", "VERIFIED", "Choice", "Platform",
-           "choose", "display_available", "probe", "render_failed", "use_platform"]
+           "choose", "display_available", "offscreen_renderer", "probe", "render_failed", "use_platform"]

@@ -11,9 +11,8 @@ absolute path, so a name like ``-x.mp4`` is never an ffmpeg option) that replace
 is closed normally; frames go to a temporary folder moved into place on close. An error, or leaving the ``with``
 block by an exception, discards them: an existing video or folder stays as it was.
 
-MuJoCo renders with the OpenGL platform it was imported with (``MUJOCO_GL``): the commands choose one that works
-before importing it (:func:`ur3hanoi.opengl.use_platform`: the display's, else EGL, else OSMesa); a script that
-renders without a display calls it first too, or sets ``MUJOCO_GL``.
+MuJoCo renders with the OpenGL platform it was imported with (``MUJOCO_GL``): call
+:func:`ur3hanoi.opengl.use_platform` first (the commands do), or set ``MUJOCO_GL``.
 """
 
 from __future__ import annotations
@@ -23,7 +22,6 @@ import math
 import os
 import re
 import signal
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,7 +32,7 @@ import numpy as np
 
 from ur3hanoi.errors import OutputError, SimulationError, Ur3HanoiError, printable, quote
 from ur3hanoi.io.atomic import PendingDir, PendingFile, check_output, check_output_dir
-from ur3hanoi.opengl import display_available, render_failed
+from ur3hanoi.opengl import display_available, offscreen_renderer
 from ur3hanoi.sim.scene import slot_centers
 from ur3hanoi.station.calibration import Station
 
@@ -154,20 +152,6 @@ def _draw(renderer: mujoco.Renderer, data: mujoco.MjData, camera: mujoco.MjvCame
     return renderer.render()
 
 
-def _renderer(model: mujoco.MjModel, cam: CameraConfig) -> mujoco.Renderer:
-    """An offscreen renderer of the camera's size. Raises SimulationError (one line) when MuJoCo's OpenGL platform
-    cannot make a context; what its library says (GLFW's warnings) goes into that line, not onto the terminal."""
-    with warnings.catch_warnings(record=True) as said:
-        warnings.simplefilter("always")
-        try:
-            return mujoco.Renderer(model, cam.height, cam.width)
-        except ValueError:  # a size the framebuffer does not hold: a bug here, not a missing OpenGL
-            raise
-        except Exception as exc:
-            reason = str(said[0].message) if said else f"{type(exc).__name__}: {exc}"
-    raise SimulationError(render_failed(" ".join(reason.split())))
-
-
 # A rendering worker process's state (set by _init_worker; one renderer per process).
 _WORKER: dict[str, Any] = {}
 
@@ -180,7 +164,7 @@ def _init_worker(parent: int, model: mujoco.MjModel, lookat: tuple[float, float,
     # One llvmpipe thread per process: the processes are the parallelism (read when the GL driver loads).
     os.environ.setdefault("LP_NUM_THREADS", "1")
     _WORKER["model"], _WORKER["data"] = model, mujoco.MjData(model)
-    _WORKER["renderer"] = _renderer(model, cam)
+    _WORKER["renderer"] = offscreen_renderer(model, cam.height, cam.width)
     _WORKER["camera"], _WORKER["cam"] = _camera(lookat, cam), cam
 
 
@@ -199,11 +183,10 @@ class OffscreenRecorder:
     is the number written. With ``workers`` > 1 the run only records each frame's joint state, and
     :meth:`render_pending` (called by the context manager on success) renders them in that many processes
     (``spawn``, one software-GL thread each), in order, reporting ``progress(fraction, label)`` per frame, while
-    ffmpeg encodes in its own process. MuJoCo renders with the OpenGL platform it was imported with (see the
-    module docstring). A video needs ``imageio-ffmpeg`` (its wheel ships ffmpeg) and an extension of
-    :data:`VIDEO_FORMATS`; PNG needs only Pillow. Use as a context manager (it closes the renderer and finishes the
-    file, or :meth:`discard` s it when the block raises). The output is checked here (:mod:`ur3hanoi.io.atomic`)
-    and written only on close.
+    ffmpeg encodes in its own process. OpenGL: see the module docstring. A video needs ``imageio-ffmpeg`` (its
+    wheel ships ffmpeg) and an extension of :data:`VIDEO_FORMATS`; PNG needs only Pillow. Use as a context manager
+    (it closes the renderer and finishes the file, or :meth:`discard` s it when the block raises). The output is
+    checked here (:mod:`ur3hanoi.io.atomic`) and written only on close.
     """
 
     def __init__(self, station: Station, model: mujoco.MjModel, frames_dir: Path | None = None,
@@ -252,7 +235,7 @@ class OffscreenRecorder:
         self.model, self.lookat = model, _lookat(station)
         self.workers, self.progress = max(1, int(workers)), progress
         self._states: list[tuple[float, Any]] = []  # (t, qpos) of the frames to render in parallel at close()
-        self.renderer = _renderer(model, cam)
+        self.renderer = offscreen_renderer(model, cam.height, cam.width)
         self.camera = _free_camera(station, cam)
         self._pool: Any = None
         if self.workers > 1:
