@@ -32,11 +32,12 @@ def test_without_a_display_or_a_setting_the_first_headless_platform_that_works_i
     assert choice.describe().startswith(f"{choice.platform.title} (MUJOCO_GL unset, no display")
 
 
-def test_a_display_that_does_not_answer_is_passed_over_without_a_warning() -> None:
+def test_a_display_that_does_not_answer_is_passed_over_without_a_warning(capfd: pytest.CaptureFixture[str]) -> None:
     """DISPLAY names an X server that is not there (a stale ssh setting): GLFW fails in the child, quietly."""
     choice = choose(_headless(DISPLAY=":9731"))
     assert choice.chosen and choice.platform in (EGL, OSMESA)
     assert choice.passed_over[0] == "the display failed"
+    assert capfd.readouterr().err == ""  # GLFW's warnings stayed in the child's pipe
 
 
 def test_the_users_setting_is_tried_alone_and_kept() -> None:
@@ -126,7 +127,8 @@ def test_with_no_platform_the_error_names_each_one_tried_and_what_provides_it() 
 
 _UNCHOSEN = """
 import mujoco
-from ur3hanoi.opengl import offscreen_renderer
+from ur3hanoi.opengl import offscreen_renderer, use_platform
+use_platform()  # too late for this process: MuJoCo has bound GLFW
 try:
     offscreen_renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), 16, 16)
 except Exception as exc:
@@ -135,8 +137,8 @@ except Exception as exc:
 
 
 def test_a_script_that_imports_mujoco_before_choosing_gets_one_line_and_no_warning() -> None:
-    """MuJoCo imported with MUJOCO_GL unset and no display binds GLFW, which cannot work: the renderer's failure is
-    one line saying what to do, and GLFW's warnings go into it, not onto stderr."""
+    """MuJoCo imported with MUJOCO_GL unset and no display binds GLFW, which cannot work, whatever is chosen after:
+    the renderer's failure is one line saying what to do, and GLFW's warnings go into it, not onto stderr."""
     proc = subprocess.run([sys.executable, "-c", _UNCHOSEN], env=_headless(), capture_output=True, text=True,
                           cwd=REPO, timeout=120, check=False)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr

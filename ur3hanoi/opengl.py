@@ -210,6 +210,7 @@ def choose(environ: Mapping[str, str] | None = None) -> Choice:
 
 
 _CHOSEN: list[Choice | SimulationError] = []  # this process's answer, once
+_TOO_LATE: list[bool] = []  # MuJoCo was imported with MUJOCO_GL unset before the answer was written
 
 
 def use_platform(environ: MutableMapping[str, str] | None = None) -> Choice:
@@ -230,6 +231,8 @@ def use_platform(environ: MutableMapping[str, str] | None = None) -> Choice:
     if isinstance(answer, SimulationError):
         raise answer
     if answer.chosen or MUJOCO_GL not in env:
+        if MUJOCO_GL not in env and "mujoco" in sys.modules:
+            _TOO_LATE.append(True)  # this process keeps MuJoCo's default; the ones it starts get the answer
         env[MUJOCO_GL] = answer.platform.name
     env[VERIFIED] = f"{answer.platform.name} {'chosen' if answer.chosen else 'set'}"
     return answer
@@ -239,7 +242,7 @@ def render_failed(reason: str, environ: Mapping[str, str] | None = None) -> str:
     """The one line when creating an offscreen renderer failed in this process (``reason``: the library's)."""
     env = os.environ if environ is None else environ
     given = env.get(MUJOCO_GL)
-    if given is None:
+    if given is None or _TOO_LATE:
         return (f"offscreen rendering is unavailable: {reason}; MuJoCo was imported with {MUJOCO_GL} unset (GLFW, "
                 f"which needs a display): call ur3hanoi.opengl.use_platform() before importing MuJoCo, or set "
                 f"{MUJOCO_GL}")

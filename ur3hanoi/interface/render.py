@@ -105,7 +105,7 @@ class FrameProcess:
         hello = self._conn.recv()
         if not str(hello).startswith("ready"):
             self._kill()
-            raise SimulationError(f"offscreen rendering failed: {str(hello).removeprefix('error: ')}")
+            raise SimulationError(f"the rendering process could not start: {str(hello).removeprefix('error: ')}")
         self.fps = float(str(hello).split()[1])
 
     def _collect(self) -> None:
