@@ -10,8 +10,9 @@ process that renders one 16x16 frame, its output kept from the terminal: the dis
 ``WAYLAND_DISPLAY`` is set, then EGL, then OSMesa. The first that works goes into ``MUJOCO_GL`` for this process and
 every process it starts. A ``MUJOCO_GL`` the user set is tried alone and never replaced.
 
-Cost: one child process per candidate tried (one where the first works), about 0.5 s of CPU, most of it importing
-MuJoCo once more (``bench/bench_opengl.py``); paid only when a command is about to render, at most once per process.
+Cost: one child process per candidate tried (one where the first works, or for the user's ``MUJOCO_GL``), 0.6-0.9 s
+of CPU, most of it importing MuJoCo once more (``bench/bench_opengl.py``); paid only when a command is about to
+render, at most once per process.
 The result is handed on through the environment (:data:`VERIFIED`): a process ur3hanoi starts (a rendering worker,
 the stations' rendering process, a command the test suite runs) finds the platform already tried and pays nothing.
 
