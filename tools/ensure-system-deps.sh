@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # System packages the project needs outside its virtual environment, installed with apt-get when missing and we
 # are root; otherwise says what to install. Python packages from PyPI are not installed here (requirements.lock).
-#  - Headless MuJoCo rendering (MUJOCO_GL=egl: --video/--frames and the notebooks): Mesa's EGL and GL drivers.
+#  - Headless MuJoCo rendering (--video/--frames and notebook 04 choose EGL without a display, ur3hanoi/opengl.py):
+#    Mesa's EGL and GL drivers.
 #  - ROS 1 for `ur3hanoi ros-station` / `ros-solve` and their tests: Debian's roscore and pure-Python rospy,
 #    genpy and std_msgs (about 40 s). ur3hanoi.interface.ros1 appends /usr/lib/python3/dist-packages to the venv's path.
 #  - Debian's chromium: the replay page's test opens it headless with the network off (tests/replay/test_page.py).

@@ -61,11 +61,15 @@ def test_the_render_sink_writes_what_the_report_counts(kind: str, tmp_path: Path
                                                        monkeypatch: pytest.MonkeyPatch) -> None:
     """ServerCore without a transport, 2 s of real time with one move of joint 1 and ``frames`` or ``video``: the
     rendering process writes as many frames as the report says it rendered (the rest dropped, not waited for),
-    the pictures are not blank and show the arm moving."""
+    the pictures are not blank and show the arm moving. Without a display or MUJOCO_GL, the process chooses its
+    OpenGL platform itself (ur3hanoi.opengl), as a script using the library would have it."""
     import imageio_ffmpeg
     from PIL import Image
 
-    monkeypatch.setenv("MUJOCO_GL", "egl")
+    from ur3hanoi.opengl import MUJOCO_GL, VERIFIED
+
+    for name in (MUJOCO_GL, VERIFIED, "DISPLAY", "WAYLAND_DISPLAY"):
+        monkeypatch.delenv(name, raising=False)
     out = tmp_path / ("run.mp4" if kind == "video" else "frames")
     node = ServerCore(ServerOptions(duration_s=2.0, **{kind: out}), out=lambda _s: None, report_out=lambda _s: None)
     q = [float(x) for x in node.world.q]

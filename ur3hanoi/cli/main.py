@@ -18,10 +18,10 @@ import warnings
 from collections.abc import Sequence
 from typing import NoReturn
 
-from ur3hanoi import __version__
 from ur3hanoi.cli import exit_codes
 from ur3hanoi.errors import Ur3HanoiError, Ur3HanoiWarning, printable
 from ur3hanoi.lifecycle import Terminated, sigterm_raises
+from ur3hanoi.version import __version__
 
 COMMAND_MODULES: dict[str, str] = {
     "tables": "tables", "check-table": "check_table", "calibrate": "calibrate", "teach": "teach", "plan": "plan",

@@ -9,7 +9,6 @@ exit code 2; a suction fault exits with 3 (after printing the ``--json`` outcome
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -71,16 +70,16 @@ def add_station_outputs(p: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=option(DURATION), metavar="S", help="stop by itself after S seconds")
     add_suction_profile_option(p)
     out = p.add_mutually_exclusive_group()
-    out.add_argument("--video", metavar="FILE.mp4", help="render an MP4 offscreen (headless: MUJOCO_GL=egl)")
-    out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR")
+    out.add_argument("--video", metavar="FILE.mp4",
+                     help="render an MP4 offscreen (OpenGL: the display's, else EGL, else OSMesa, or MUJOCO_GL)")
+    out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR (OpenGL as --video)")
 
 
 def check_station_outputs(args: argparse.Namespace, default_calibration: str) -> Path | None:
     """Refuse a ``--report``, ``--video`` or ``--frames`` that cannot be written (:mod:`ur3hanoi.io.atomic`), before
-    any work; returns the report file (None: standard output, also for ``--report -``). Sets ``MUJOCO_GL=egl``
-    for rendering on a machine without a display."""
-    if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
-        os.environ["MUJOCO_GL"] = "egl"  # headless offscreen rendering (read when the GL context is created)
+    any work; returns the report file (None: standard output, also for ``--report -``). With ``--video`` or
+    ``--frames``, chooses the OpenGL platform the rendering process will use (it inherits ``MUJOCO_GL``) and says
+    which on stderr."""
     from ur3hanoi.cli.common import check_render_outputs, input_file
     from ur3hanoi.io.atomic import check_output
 
@@ -88,7 +87,9 @@ def check_station_outputs(args: argparse.Namespace, default_calibration: str) ->
     report = None if args.report in (None, "-") else Path(args.report)
     if report is not None:
         check_output(report, inputs=inputs)
-    check_render_outputs(args.video, args.frames, inputs)
+    gl = check_render_outputs(args.video, args.frames, inputs)
+    if gl is not None:
+        print(f"ur3hanoi {args.command}: rendering with {gl.describe()}", file=sys.stderr, flush=True)
     return report
 
 
