@@ -34,8 +34,13 @@ from ur3hanoi.station.calibration import Station
 LIMIT_MARGIN = 1.02
 """A target within ``LIMIT_MARGIN x`` the joint limits is followed exactly: the controller's quintic between the
 samples of a plan at the limits overshoots them by a fraction of a percent."""
-SCALING_RECOVERY_PER_S = 2.0
-"""How fast [1/s] the robot's own speed scaling returns towards 1 once it follows its target again (0.5 s from 0)."""
+PEAK_ACCELERATION = 5.0
+"""The robot follows a target's transients (a velocity step of linear interpolation, a scaling change) with up to
+this many times the acceleration limits, as a real UR's servo does (the datasheet gives no joint acceleration; the
+limits of :class:`~ur3hanoi.robot.model.JointLimits` are the planner's)."""
+SCALING_CHANGE_PER_S = 2.0
+"""How fast [1/s] the robot's own speed scaling changes (0.5 s from 1 to 0): the robot ramps its speed, so a target
+asking too much is limited (and the robot falls behind) until the scaling has come down."""
 HOLD_FRICTION_NM = 1000.0
 """The clamp of :meth:`ServoWorld.hold_arm`: dry friction [N m] on every arm joint, far beyond the UR3's joint torques
 (MuJoCo's ``frictionloss`` constraint, stable at any stiffness)."""
@@ -63,7 +68,6 @@ class ServoWorld(TaskWorld):
         self.ref_q: FloatArray = station.q_home_array.copy()  # the robot's own reference [rad]
         self.ref_qd: FloatArray = np.zeros_like(self.ref_q)  # [rad/s]
         self._target: FloatArray = self.ref_q.copy()  # the last target [rad]
-        self._target_qd: FloatArray = np.zeros_like(self.ref_q)  # its last velocity (finite difference) [rad/s]
         self.limited = False  # the last cycle had to limit the target
         self._motion_s: float | None = None
         self._hold_left = 0.0
@@ -95,19 +99,27 @@ class ServoWorld(TaskWorld):
         dt = self.config.period_s
         step = target - self._target  # the target's own motion this cycle
         gap = self._target - self.ref_q  # how far behind the robot was
-        close = np.sign(gap) * np.minimum(np.abs(gap) / dt, np.sqrt(2.0 * self.a_max * np.abs(gap)))
+        close = np.sign(gap) * np.minimum(np.abs(gap) / dt, np.sqrt(2.0 * self.a_max * PEAK_ACCELERATION * np.abs(gap)))
         want = step / dt + close
-        qd = np.clip(want, self.ref_qd - self.a_max * dt, self.ref_qd + self.a_max * dt)
+        a_peak = self.a_max * PEAK_ACCELERATION
+        qd = np.clip(want, self.ref_qd - a_peak * dt, self.ref_qd + a_peak * dt)
         qd = np.clip(qd, -self.v_max, self.v_max)
         self.limited = not np.allclose(qd, want, rtol=0.0, atol=1e-12)
-        # The scaling at which the commanded motion would have been feasible: speed ~ s, acceleration ~ s^2.
-        w = step / dt
-        acc = (w - self._target_qd) / dt
-        with np.errstate(divide="ignore"):
-            fit = min(float(np.min(self.v_max / np.abs(w))), float(np.sqrt(np.min(self.a_max / np.abs(acc)))))
-        self._target_qd = w
-        self.own_scaling = min(1.0, self.own_scaling + SCALING_RECOVERY_PER_S * dt, self.own_scaling * fit)
         return self.ref_q + qd * dt, qd
+
+    def _rescale(self, qd: FloatArray, qdd: FloatArray) -> None:
+        """Move the robot's own scaling towards the largest at which the controller's trajectory (its velocity
+        ``qd`` and acceleration ``qdd`` at the current scaling) fits the limits, at most
+        :data:`SCALING_CHANGE_PER_S` per second."""
+        s = self.speed_scaling
+        if s <= 0.0:
+            return
+        v, a = np.abs(qd) / s, np.abs(qdd) / (s * s)  # the trajectory's own, in its time
+        with np.errstate(divide="ignore"):
+            fits = min(float(np.min(self.v_max / v)), float(np.sqrt(np.min(self.a_max / a))))
+        goal = min(1.0, fits / self.slider)
+        rate = SCALING_CHANGE_PER_S * self.config.period_s
+        self.own_scaling = float(np.clip(goal, self.own_scaling - rate, self.own_scaling + rate))
 
     def step(self, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> None:
         """One control cycle towards the controller's target ``q`` [rad] (with its wall-time velocity ``qd`` [rad/s]
@@ -116,6 +128,7 @@ class ServoWorld(TaskWorld):
         dt = self.config.period_s
         target = np.asarray(q, dtype=float)
         ref, ref_qd = self._limit(target)
+        self._rescale(np.asarray(qd, dtype=float), np.asarray(qdd, dtype=float))
         exact = not self.limited and np.allclose(ref, target, rtol=0.0, atol=1e-12)
         acc = np.asarray(qdd, dtype=float) if exact else (ref_qd - self.ref_qd) / dt
         vel = np.asarray(qd, dtype=float) if exact else ref_qd

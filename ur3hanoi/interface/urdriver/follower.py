@@ -44,6 +44,8 @@ from ur3hanoi.interface.urdriver.spline import JointState, Segment, find_segment
 
 Status = Literal["succeeded", "aborted", "preempted", "canceled"]
 BoolArray = npt.NDArray[np.bool_]
+TIME_RESOLUTION_S = 1e-9
+"""Times closer than this [s] are equal: ROS times are whole nanoseconds (the controllers compare them exactly)."""
 
 
 @dataclass(frozen=True)
@@ -170,7 +172,7 @@ class TrajectoryFollower:
             return None
         start = now + (goal.start_in_s or 0.0)
         times = [start + p.time_from_start_s for p in goal.points]
-        first = next((k for k, t in enumerate(times) if t > now), None)
+        first = next((k for k, t in enumerate(times) if t > now + TIME_RESOLUTION_S), None)
         if first is None:
             n = len(goal.points)
             text = (f"Dropping all {n} trajectory point(s), as they occur before the current time.\n"
@@ -242,7 +244,7 @@ class TrajectoryFollower:
 
     def _check(self, active: _Active, seg: Segment, last: bool, err_q: FloatArray, err_qd: FloatArray) -> None:
         tol, prof = active.tolerances, self.profile
-        if self.uptime < seg.end_s:
+        if self.uptime < seg.end_s - TIME_RESOLUTION_S:
             active.max_path_error = max(active.max_path_error, float(np.max(np.abs(err_q))))
             bad = _outside(err_q, err_qd, tol.path, tol.path_v)
             if bad is not None:
@@ -255,7 +257,8 @@ class TrajectoryFollower:
             return
         inside = _inside(err_q, err_qd, tol.goal, tol.goal_v)
         late = self.uptime - seg.end_s
-        out_of_time = not (prof.goal_time_zero_waits and tol.goal_time_s == 0.0) and late >= tol.goal_time_s
+        out_of_time = (not (prof.goal_time_zero_waits and tol.goal_time_s == 0.0)
+                       and late >= tol.goal_time_s - TIME_RESOLUTION_S)
         if prof.validation == "ros1":  # per joint, in order; a joint once inside stays counted as arrived
             for i in range(self.n):
                 if inside[i]:
