@@ -102,6 +102,21 @@ def _checked(opts: ServerOptions, n_heights: int, robot_rate_hz: float) -> tuple
     return n_blocks, rate
 
 
+def _spawn_or_remove(core: ServerCore[Any], kind: str, payload: Any) -> None:
+    """Respawn the blocks on tower ``payload`` (``spawn``) or take block ``payload`` away (``remove``), numbered
+    from 1; a bad number is logged."""
+    topic, w = core.TOPIC_LOG[kind], core.world
+    n = core.station.n_towers if kind == "spawn" else w.n_blocks
+    if not (isinstance(payload, int) and 1 <= payload <= n):
+        core.log.log(topic, "error", f"{'tower' if kind == 'spawn' else 'block'} {payload!r} is invalid: expected "
+                                     f"1..{n}")
+    elif kind == "spawn":
+        w.spawn(payload - 1)
+        core.log.log(topic, "info", f"{w.n_blocks} blocks respawned on tower {payload}")
+    else:
+        core.log.log(topic, "warn", f"block {payload} {w.remove(payload - 1)}")
+
+
 class ServerCore(Generic[WorldT]):
     """The simulated station as a real-time node without a transport (see the module docstring).
 
@@ -205,20 +220,8 @@ class ServerCore(Generic[WorldT]):
         """One message from the inbox: a command, a spawn or a removal (a subclass adds its own kinds)."""
         if kind == "command":
             self.submit_command(payload)
-        elif kind == "spawn":
-            n = self.station.n_towers
-            if isinstance(payload, int) and 1 <= payload <= n:
-                self.world.spawn(payload - 1)
-                self.log.log(self.TOPIC_LOG[kind], "info", f"{self.world.n_blocks} blocks respawned on tower {payload}")
-            else:
-                self.log.log(self.TOPIC_LOG[kind], "error", f"tower {payload!r} is invalid: expected 1..{n}")
-        elif kind == "remove":
-            n = self.world.n_blocks
-            if isinstance(payload, int) and 1 <= payload <= n:
-                what = self.world.remove(payload - 1)
-                self.log.log(self.TOPIC_LOG[kind], "warn", f"block {payload} {what}")
-            else:
-                self.log.log(self.TOPIC_LOG[kind], "error", f"block {payload!r} is invalid: expected 1..{n}")
+        else:
+            _spawn_or_remove(self, kind, payload)
 
     # --------------------------------------------------------------------------------------------- rendering
     @contextmanager
@@ -261,36 +264,7 @@ class ServerCore(Generic[WorldT]):
 
     def report(self) -> dict[str, Any]:
         """The JSON report (see the module docstring); numbering from 1."""
-        w, st = self.world, self.station
-        events = [e.as_dict() for e in w.events]  # the last EVENTS_KEPT; counts of all in "event_counts"
-        wall = self.clock.wall_s
-        holding = w.holding
-        return {
-            "station": {"name": st.name, "calibration": st.source, "sha256": st.sha256, "robot": st.robot.name},
-            "suction": w.cup.profile.as_dict(),
-            **self._report_transport(),
-            "blocks": w.n_blocks,
-            "start_tower": self.options.start + 1,
-            "wall_time_s": round(wall, 3),
-            "world_time_s": round(w.time, 3),
-            "control": self.clock.timing.as_dict(wall),
-            **self._report_motion(),
-            "suction_events": [e for e in events if e["kind"] in _SUCTION_KINDS],
-            "faults": [e for e in events if e["kind"] in ("removed", "dropped")],
-            "spawns": [e for e in events if e["kind"] == "spawn"],
-            "event_counts": dict(w.event_counts),
-            "log_lines": self.log.lines,
-            "final": {
-                "q": [round(float(x), 9) for x in w.q],
-                **self._report_final(),
-                "suction_on": w.suction_on,
-                "holding": None if holding is None else holding + 1,
-                "at_home": w.at_home(),
-                "blocks": [b.as_dict() for b in w.blocks()],
-            },
-            "frames": self.frames.counts(),
-            "reports_written": self.reports_written + 1,
-        }
+        return _report(self)
 
     def write_report(self) -> dict[str, Any]:
         """Write :meth:`report` to ``options.report`` (atomically) or to ``report_out``; returns it."""
@@ -323,3 +297,37 @@ class ServerCore(Generic[WorldT]):
 
         self.out(ready_line)
         self.clock.run(step, running, self.write_report, self.options.duration_s)
+
+
+def _report(core: ServerCore[Any]) -> dict[str, Any]:
+    """:meth:`ServerCore.report`."""
+    w, st = core.world, core.station
+    events = [e.as_dict() for e in w.events]  # the last EVENTS_KEPT; counts of all in "event_counts"
+    wall = core.clock.wall_s
+    holding = w.holding
+    return {
+        "station": {"name": st.name, "calibration": st.source, "sha256": st.sha256, "robot": st.robot.name},
+        "suction": w.cup.profile.as_dict(),
+        **core._report_transport(),
+        "blocks": w.n_blocks,
+        "start_tower": core.options.start + 1,
+        "wall_time_s": round(wall, 3),
+        "world_time_s": round(w.time, 3),
+        "control": core.clock.timing.as_dict(wall),
+        **core._report_motion(),
+        "suction_events": [e for e in events if e["kind"] in _SUCTION_KINDS],
+        "faults": [e for e in events if e["kind"] in ("removed", "dropped")],
+        "spawns": [e for e in events if e["kind"] == "spawn"],
+        "event_counts": dict(w.event_counts),
+        "log_lines": core.log.lines,
+        "final": {
+            "q": [round(float(x), 9) for x in w.q],
+            **core._report_final(),
+            "suction_on": w.suction_on,
+            "holding": None if holding is None else holding + 1,
+            "at_home": w.at_home(),
+            "blocks": [b.as_dict() for b in w.blocks()],
+        },
+        "frames": core.frames.counts(),
+        "reports_written": core.reports_written + 1,
+    }
