@@ -14,3 +14,7 @@ def test_results_carry_the_drivers_code_and_string():
     assert GoalResult("canceled").describe() == "canceled"
     assert GoalResult("rejected").describe() == "rejected at send_goal (the ROS 2 driver gives no code: its log " \
                                                 "says why)"
+
+
+def test_a_preempted_goal_names_the_likely_causes():
+    assert "does the robot program run on the pendant?" in GoalResult("preempted").describe()

@@ -161,3 +161,19 @@ def test_io_states_read_the_suction_on_the_calibrations_pins(tmp_path):
     tr.wait(0.0)
     assert st.world.suction_on and not st.output.io.digital_in[5]  # on, nothing held: the switch reads 0
     assert st.output.io.analog_in[1][1] == pytest.approx(profile.ain0_free, abs=0.05)
+
+
+def test_a_stopped_robot_program_preempts_the_goal_and_refuses_new_ones(home):
+    st, tr = fresh()
+    h = tr.send_goal(goal(home + 0.5, 2.0, home))
+    for _ in range(50):
+        tr.wait(0.0)
+    st.on_program(False)
+    tr.wait(0.0)
+    assert h.done() and h.result().status == "preempted"
+    r, _ = send(tr, goal(home, 1.0, st.world.q))
+    assert (r.status, r.code, r.error_string) == ("rejected", ErrorCode.INVALID_GOAL,
+                                                  "Can't accept new commands. Controller is not running.")
+    st.on_program(True)
+    assert send(tr, goal(home, 1.0, st.world.q))[0].status == "succeeded"
+    assert st.report()["final"]["program_running"]

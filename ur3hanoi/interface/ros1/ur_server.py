@@ -15,7 +15,10 @@ and order are the driver's (:data:`ur3hanoi.interface.urdriver.facts.ROS1`):
   see :class:`EitherSetIoSum`) and to ``md5sum *``;
 - ``/ur_hardware_interface/io_states`` (``ur_msgs/IOStates``) and ``/speed_scaling_factor`` (``std_msgs/Float64``, a
   fraction) every cycle;
-- fault injection: ``/ur3hanoi/hold_arm`` (``std_msgs/Float64``: seconds the arm is held where it is).
+- ``/ur_hardware_interface/robot_program_running`` (``std_msgs/Bool``, latched);
+- fault injection: ``/ur3hanoi/hold_arm`` (``std_msgs/Float64``: seconds the arm is held where it is) and
+  ``/ur3hanoi/program_running`` (``std_msgs/Bool``: false stops the robot program, as on the pendant: the running
+  goal is preempted, new goals get INVALID_GOAL until it runs again).
 """
 
 from __future__ import annotations
@@ -36,6 +39,10 @@ from ur3hanoi.interface.urdriver.station import DriverStation, DriverStationOpti
 
 HOLD_TOPIC = "/ur3hanoi/hold_arm"
 """Fault injection: ``std_msgs/Float64`` seconds the arm is held (a person or an obstacle in the way)."""
+PROGRAM_TOPIC = "/ur3hanoi/program_running"
+"""Fault injection: ``std_msgs/Bool`` false = the robot program stopped on the pendant (the controller stops)."""
+PROGRAM_RUNNING = "/ur_hardware_interface/robot_program_running"
+"""The driver's latched ``std_msgs/Bool``: whether the robot program runs."""
 
 
 class EitherSetIoSum(str):
@@ -85,7 +92,8 @@ class RosDriverServer(RosServer, DriverStation):
 
     TOPIC_LOG: ClassVar[dict[str, str]] = {"goal": "follow_joint_trajectory", "cancel": "follow_joint_trajectory",
                                            "hold": HOLD_TOPIC.lstrip("/"), "io": "ur_hardware_interface/set_io",
-                                           "spawn": "ur3hanoi/spawn", "remove": "ur3hanoi/remove_block"}
+                                           "spawn": "ur3hanoi/spawn", "remove": "ur3hanoi/remove_block",
+                                           "program": PROGRAM_TOPIC.lstrip("/")}
 
     def __init__(self, options: RosDriverOptions, out: Callable[[str], None] | None = None,
                  report_out: Callable[[str], None] | None = None) -> None:
@@ -130,6 +138,10 @@ class RosDriverServer(RosServer, DriverStation):
         server.start()
         rospy.Service(ROS1.set_io, set_io, self._on_set_io)
         rospy.Subscriber(HOLD_TOPIC, std_msgs.Float64, lambda msg: self.on_hold(msg.data), queue_size=10)
+        rospy.Subscriber(PROGRAM_TOPIC, std_msgs.Bool, lambda msg: self.on_program(msg.data), queue_size=10)
+        program = rospy.Publisher(PROGRAM_RUNNING, std_msgs.Bool, queue_size=1, latch=True)
+        running = [True]
+        program.publish(std_msgs.Bool(True))
         order = np.array([CONTROLLER_JOINTS.index(n) for n in ROS1_JOINT_STATE_ORDER])
         unit = self.options.profile.speed_scaling_unit
 
@@ -141,6 +153,9 @@ class RosDriverServer(RosServer, DriverStation):
             pubs[0].publish(js)
             pubs[1].publish(self._io_msg(m, out.io))
             pubs[2].publish(std_msgs.Float64(out.speed_scaling * unit))
+            if self.follower.running != running[0]:
+                running[0] = self.follower.running
+                program.publish(std_msgs.Bool(running[0]))
             self._goal_events(m, out.decisions, out.feedback, out.results, rospy.Time.now())
 
         return publish

@@ -36,6 +36,9 @@ class GoalResult:
         (ROS 2 rejects at ``send_goal``) says where to look."""
         if self.status == "rejected" and self.code is None:
             return "rejected at send_goal (the ROS 2 driver gives no code: its log says why)"
+        if self.status == "preempted":
+            return "preempted (by another client's goal, or the controller stopped: does the robot program run on " \
+                   "the pendant?)"
         text = self.status if self.code is None else f"{self.status}: {code_name(self.code)}"
         return text + (f' "{self.error_string}"' if self.error_string else ' (no error string)' if self.code else "")
 

@@ -196,6 +196,15 @@ class TrajectoryFollower:
         if self.active is not None:
             self._end("preempted", ErrorCode.SUCCESSFUL, "")
 
+    def set_running(self, running: bool) -> None:
+        """Start or stop the controller (the driver's ``controller_stopper`` while the robot program is stopped on
+        the pendant): stopping preempts the active goal and brings the arm to rest; a stopped controller refuses
+        goals (INVALID_GOAL "Can't accept new commands. Controller is not running.")."""
+        if self.running and not running:
+            self._preempt()
+            self._stop(self.uptime)
+        self.running = running
+
     def cancel(self, key: Hashable) -> bool:
         """Cancel goal ``key`` if it is the active one (True): it ends "canceled" and the arm ramps to rest."""
         if self.active is None or self.active.key != key:

@@ -87,7 +87,7 @@ class DriverStation(ServerCore["ServoWorld"]):
 
     TOPIC_LOG: ClassVar[dict[str, str]] = {"goal": "follow_joint_trajectory", "cancel": "follow_joint_trajectory",
                                            "hold": "hold_arm", "io": "set_io", "spawn": "spawn",
-                                           "remove": "remove_block"}
+                                           "remove": "remove_block", "program": "program_running"}
 
     def __init__(self, options: DriverStationOptions, out: Any, report_out: Any) -> None:
         super().__init__(options, out, report_out)
@@ -115,6 +115,11 @@ class DriverStation(ServerCore["ServoWorld"]):
     def on_cancel(self, key: Hashable) -> None:
         """A cancel request for goal ``key`` (any thread)."""
         self.inbox.offer("cancel", (key, time.monotonic()))
+
+    def on_program(self, running: bool) -> None:
+        """Fault injection (any thread): the robot program stopped (False) or started again (True) on the pendant;
+        the driver stops its trajectory controller meanwhile."""
+        self.inbox.offer("program", bool(running))
 
     def on_hold(self, seconds: float) -> None:
         """Fault injection (any thread): clamp the arm where it is for ``seconds`` (0 releases it)."""
@@ -147,6 +152,9 @@ class DriverStation(ServerCore["ServoWorld"]):
             self.log.log(self.TOPIC_LOG[kind], "warn", f"the arm is held for {float(payload):g} s")
         elif kind == "io":
             self.records.io_call(t, *payload)
+        elif kind == "program":
+            self.follower.set_running(payload)
+            self.log.log(self.TOPIC_LOG[kind], "warn", f"the robot program {'runs' if payload else 'stopped'}")
         else:
             super()._handle(kind, payload)
 
@@ -198,5 +206,5 @@ class DriverStation(ServerCore["ServoWorld"]):
                 "halts": [h.as_dict() for h in self.records.halts]}
 
     def _report_final(self) -> dict[str, Any]:
-        return {"goal_active": self.follower.active is not None,
+        return {"goal_active": self.follower.active is not None, "program_running": self.follower.running,
                 "speed_scaling": round(self.world.speed_scaling, 6)}
