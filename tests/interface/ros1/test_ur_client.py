@@ -22,28 +22,23 @@ def solve(env: dict[str, str], *args: str, timeout: float = 120.0) -> subprocess
     return run(ur3hanoi_cmd("ros-solve", "--driver", "ur", "--start", "1", "--end", "3", *args), env, timeout)
 
 
-def test_a_solve_through_the_ur_driver_interface(tmp_path):
+def test_a_solve_then_a_dropped_block_halt_through_the_ur_driver_interface(tmp_path):
+    """One station for both: a 1-block solve from tower 1 to 3, then back, where the second grasp drops its block."""
     env = ros_env(free_port(), tmp_path)
-    with roscore(env), station(env, tmp_path, "--driver", "ur", "--blocks", "1") as st:
-        result = solve(env, "--blocks", "1", "--json")
+    with roscore(env), station(env, tmp_path, "--driver", "ur", "--blocks", "1", "--drop-on-grasp", "2") as st:
+        solved = solve(env, "--blocks", "1", "--json")
+        mid = st.snapshot()
+        halted = run(ur3hanoi_cmd("ros-solve", "--driver", "ur", "--start", "3", "--end", "1", "--blocks", "1"), env,
+                     120.0)
         report = st.stop()
-    assert result.returncode == 0, result.stdout + result.stderr
-    outcome = json.loads(result.stdout.strip().splitlines()[-1])
+    assert solved.returncode == 0, solved.stdout + solved.stderr
+    outcome = json.loads(solved.stdout.strip().splitlines()[-1])
     assert outcome["status"] == "solved" and outcome["moves"] == 1 and outcome["goals"] == 3
-    assert final_slots(report) == {1: (3, 1)}
-    assert report["goals"]["succeeded"] == 3 and report["goals"]["aborted"] == 0
-    assert len(report["io_calls"]) == 2 and report["final"]["at_home"] and not report["final"]["suction_on"]
-
-
-def test_a_dropped_block_halts_exit_3_one_line(tmp_path):
-    env = ros_env(free_port(), tmp_path)
-    with roscore(env), station(env, tmp_path, "--driver", "ur", "--blocks", "1", "--drop-on-grasp", "1") as st:
-        result = solve(env, "--blocks", "1")
-        report = st.stop()
-    assert result.returncode == 3, result.stdout + result.stderr
-    errors = [line for line in result.stderr.splitlines() if line.startswith("ur3hanoi: error")]
-    assert errors == [errors[0]] and "green block 1 was dropped while carrying it from tower 1 to tower 3" in errors[0]
-    assert len(report["halts"]) == 1 and report["halts"][0]["cycles"] >= 1
+    assert final_slots(mid) == {1: (3, 1)} and mid["goals"]["succeeded"] == 3 and len(mid["io_calls"]) == 2
+    assert halted.returncode == 3, halted.stdout + halted.stderr
+    errors = [line for line in halted.stderr.splitlines() if line.startswith("ur3hanoi: error")]
+    assert len(errors) == 1 and "green block 1 was dropped while carrying it from tower 3 to tower 1" in errors[0]
+    assert len(report["halts"]) == 1 and report["halts"][0]["cycles"] >= 1 and report["goals"]["canceled"] == 1
     assert report["final"]["at_home"] and not report["final"]["suction_on"]
 
 
