@@ -51,6 +51,8 @@ if TYPE_CHECKING:
 
 WorldT = TypeVar("WorldT", bound="TaskWorld")
 
+BEHIND_WARNING_S = 0.1
+"""A control loop more than this [s] behind its schedule says so on its log, once a second."""
 _SUCTION_KINDS = frozenset({"suction_on", "suction_off", "grasp", "release"})
 
 
@@ -294,6 +296,10 @@ class ServerCore(Generic[WorldT]):
             self.cycle()
             publish()
             self.frames.offer(self.world.time, self.world.scene.data.qpos)
+            lag = self.clock.timing.last_lag_s
+            if lag > BEHIND_WARNING_S:  # at most one line a second (RateLimitedLog)
+                self.log.log("loop", "warn", f"the station is {1e3 * lag:.0f} ms behind real time: the machine "
+                             "is too busy for this control rate (close other programs, or lower --rate)")
 
         self.out(ready_line)
         self.clock.run(step, running, self.write_report, self.options.duration_s)
