@@ -101,10 +101,10 @@ def test_the_render_sink_writes_what_the_report_counts(kind: str, tmp_path: Path
 
 
 def test_a_station_behind_real_time_says_so() -> None:
-    """A publish step that stalls the loop 0.3 s once: one warning line naming how far behind it is."""
+    """A publish step that stalls the loop 0.45 s once: one warning line naming how far behind it is."""
     logged: list[str] = []
     node = ServerCore(ServerOptions(duration_s=0.6), out=logged.append, report_out=lambda _s: None)
-    stalls = iter([0.3])
+    stalls = iter([0.45])
 
     def publish() -> None:
         import time

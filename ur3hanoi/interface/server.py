@@ -51,7 +51,7 @@ if TYPE_CHECKING:
 
 WorldT = TypeVar("WorldT", bound="TaskWorld")
 
-BEHIND_WARNING_S = 0.1
+BEHIND_WARNING_S = 0.25
 """A control loop more than this [s] behind its schedule says so on its log, once a second."""
 _SUCTION_KINDS = frozenset({"suction_on", "suction_off", "grasp", "release"})
 
