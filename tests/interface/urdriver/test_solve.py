@@ -139,3 +139,17 @@ def test_the_clients_goal_timeout_counts_the_speed_scaling():
     with pytest.raises(DriverError, match=r"goal 1/3 \(approach of move 1\) did not finish within \d+\.\d s of "
                                           r"trajectory time .*: canceled, suction off"):
         solve(1, FullSpeedLiar, DriverSolveConfig(goal_margin_s=0.5), speed_scaling=0.3)
+
+
+def test_a_hand_recorded_tables_plan_runs_too():
+    """``--table``: the plan through the table's waypoints (rest to rest, as the lab program moves) is cut at its
+    dwells and run the same way."""
+    from ur3hanoi.plan import plan_table
+    from ur3hanoi.tables.ik_table import generate_table
+
+    st = station(n_blocks=1)
+    p = plan_table(st.station, generate_table(st.station).q, 0, 2, 1, PlanConfig())
+    tr = LoopbackTransport(st)
+    tr.connect()
+    result = run_driver_solve(tr, p, st.station.wiring)
+    assert slots(st) == {1: (3, 1)} and result.executed_s == pytest.approx(p.duration_s, rel=0.02)
