@@ -1,4 +1,5 @@
-"""The ROS 2 subcommands of ``ur3hanoi``: ``ros2-station`` and ``ros2-solve`` (no ROS installation: Cyclone DDS).
+"""The ROS 2 subcommands of ``ur3hanoi``: ``ros2-station`` and ``ros2-solve`` (the course topics: no ROS installation,
+Cyclone DDS) and ``ros2-env`` (rclpy for the UR driver's interface).
 
 Conventions as in :mod:`ur3hanoi.cli.ros`: towers, heights, blocks and grasps numbered from 1; errors one line with
 exit code 2; a suction fault exits with 3. Heavy imports (MuJoCo, Cyclone DDS) happen only when a command runs.
@@ -56,9 +57,10 @@ def add_dds_options(p: argparse.ArgumentParser) -> None:
 
 
 def add(sub: argparse._SubParsersAction) -> None:
-    """Add ``ros2-station`` and ``ros2-solve`` to ``sub``."""
+    """Add ``ros2-station``, ``ros2-solve`` and ``ros2-env`` to ``sub``."""
     _add_station(sub)
     _add_solve(sub)
+    _add_env(sub)
 
 
 def _add_station(sub: argparse._SubParsersAction) -> None:
@@ -112,3 +114,44 @@ def _run_solve(args: argparse.Namespace) -> int:
     connected = (f"connected on ROS_DOMAIN_ID {domain} ({args.network}): {job.n_blocks} blocks, tower "
                  f"{job.start + 1} -> {job.end + 1}")
     return remote.drive(args, arm, job, connected, outcome)
+
+
+_ENV_DESCRIPTION = (
+    "Build once, in the user cache, a separate environment with the ROS 2 rclpy wheels from PyPI for this Python "
+    "(Jazzy: Fast-RTPS 2.14; Kilted: Fast DDS 3.2) and the UR driver's control_msgs and ur_msgs built from their "
+    "official texts (needs cmake, make, a C++ compiler and this Python's headers; about 2 minutes the first time), "
+    "then print the lines that let ur3hanoi use it: eval \"$(ur3hanoi ros2-env)\". Humble and Jazzy robots share "
+    "one environment, Kilted and Lyrical (control_msgs >= 6.3) the other. Not needed with a sourced ROS 2 "
+    "installation built for this Python.")
+
+
+def _add_env(sub: argparse._SubParsersAction) -> None:
+    from ur3hanoi.interface.ros2.rclpy_env import ROS_DISTROS
+
+    p = sub.add_parser("ros2-env", help="build rclpy and the UR driver's messages once, print the environment to eval",
+                       description=_ENV_DESCRIPTION)
+    p.add_argument("--distro", choices=sorted(ROS_DISTROS), default=None,
+                   help="the robot's ROS 2 distribution (default: $ROS_DISTRO if it is one of these, else jazzy)")
+    p.add_argument("--dir", metavar="DIR", help="folder of the environments (default: $XDG_CACHE_HOME/ur3hanoi)")
+    p.set_defaults(func=_run_env)
+
+
+def _run_env(args: argparse.Namespace) -> int:
+    import sys
+    from pathlib import Path
+
+    from ur3hanoi.interface.ros2.rclpy_build import WHEELS, ensure_env
+    from ur3hanoi.interface.ros2.rclpy_env import ROS_DISTROS, default_distro
+    from ur3hanoi.io.cache import cache_dir
+
+    distro = args.distro or default_distro()
+    cache = Path(args.dir).resolve() if args.dir else cache_dir()
+
+    def log(line: str) -> None:
+        print(f"# ur3hanoi ros2-env: {line}", file=sys.stderr, flush=True)
+
+    env = ensure_env(cache, WHEELS[ROS_DISTROS[distro]], sys.executable, log=log)
+    log(f"rclpy ({env.wheels} wheels, Python {env.python}) and {', '.join(env.packages)} in {env.root}")
+    for line in env.shell_lines(distro):
+        print(line)
+    return 0
