@@ -61,8 +61,9 @@ def add_station_options(p: argparse.ArgumentParser, default_calibration: str, an
     p.add_argument("--drop-on-grasp", type=option(MOVE), metavar="K",
                    help="fault injection: the block of the K-th grasp falls off during the next motion")
     p.add_argument("--seed", type=option(SEED), default=0, metavar="K", help=f"seed of the {analog} noise")
-    p.add_argument("--rate", type=option(ROS_RATE), default=125.0, metavar="HZ",
-                   help=f"control and publishing rate, 50..500 Hz, period a multiple of 2 ms (default 125{rate_note})")
+    p.add_argument("--rate", type=option(ROS_RATE), default=None, metavar="HZ",
+                   help=f"control and publishing rate, 50..500 Hz, period a multiple of 2 ms (default 125{rate_note}; "
+                        "with --driver ur the robot's control rate: 125 on a UR3, 500 on a UR3e)")
 
 
 def add_station_outputs(p: argparse.ArgumentParser) -> None:
@@ -97,13 +98,18 @@ def station_options(args: argparse.Namespace, default_calibration: str, report: 
     return {"calibration": args.calibration or default_calibration, "start": args.start - 1,
             "n_blocks": args.blocks, "removed": None if args.remove_block is None else args.remove_block - 1,
             "drop_on_grasp": None if args.drop_on_grasp is None else args.drop_on_grasp - 1, "seed": args.seed,
-            "rate_hz": args.rate, "report": report, "duration_s": args.duration,
+            "rate_hz": args.rate if args.rate is not None or getattr(args, "driver", "course") == "ur" else 125.0,
+            "report": report, "duration_s": args.duration,
             "suction_profile": args.suction_profile, "frames": Path(args.frames) if args.frames else None,
             "video": Path(args.video) if args.video else None}
 
 
 def stopped_line(command: str, report: dict[str, Any], extra: str = "") -> str:
-    """``COMMAND stopped: N commands executed, M refused; EXTRA`` (``extra`` ends with the report file)."""
+    """``COMMAND stopped: N commands executed, M refused; EXTRA`` (``extra`` ends with the report file); with the
+    UR driver's interface ``N goals accepted, M rejected``."""
+    if "goals" in report:
+        g = report["goals"]
+        return f"{command} stopped: {g['accepted']} goals accepted, {g['rejected']} rejected; {extra}"
     c = report["commands"]
     return f"{command} stopped: {c['executed']} commands executed, {c['rejected']} refused; {extra}"
 
