@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 
-from ur3hanoi.cli import remote
+from ur3hanoi.cli import driver, remote
 
 DEFAULT_ROS2_CALIBRATION = "ur3e_sim"
 _DOMAIN_HELP = "ROS_DOMAIN_ID, 0..232 (default: $ROS_DOMAIN_ID, else 0)"
@@ -70,18 +70,43 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
                    help="bridge: fixed 2 s moves, is_ready always true (default); honest: the controller's movej at "
                         "the message's v and a, is_ready = arrived")
     add_dds_options(p)
+    driver.add_driver_option(p, station=True)
+    add_distro_option(p)
     remote.add_station_outputs(p)
     p.set_defaults(func=_run_station)
 
 
+def add_distro_option(p: argparse.ArgumentParser) -> None:
+    """``--ros-distro``: the UR driver's names and controller rules (with ``--driver ur``)."""
+    from ur3hanoi.interface.ros2.rclpy_env import ROS_DISTROS
+
+    p.add_argument("--ros-distro", choices=list(ROS_DISTROS), default=None, metavar="DISTRO",
+                   help="with --driver ur: the robot's ROS 2 distribution, humble, jazzy, kilted (the scaled "
+                        "trajectory controller) or lyrical (joint_trajectory_controller); default $ROS_DISTRO if it "
+                        "is one of these, else jazzy")
+
+
+def _distro(args: argparse.Namespace) -> str:
+    from ur3hanoi.interface.ros2.rclpy_env import default_distro
+
+    return str(args.ros_distro or default_distro())
+
+
 def _run_station(args: argparse.Namespace) -> int:
     report_file = remote.check_station_outputs(args, DEFAULT_ROS2_CALIBRATION)  # before any work
-    from ur3hanoi.interface.ros2.server import Ros2Server, Ros2ServerOptions
+    fields = remote.station_options(args, DEFAULT_ROS2_CALIBRATION, report_file)
+    if args.driver == "ur":
+        from ur3hanoi.interface.ros2.ur_station import Ros2DriverOptions, Ros2DriverStation
 
-    options = Ros2ServerOptions(**remote.station_options(args, DEFAULT_ROS2_CALIBRATION, report_file),
-                                 timing=args.timing, convention=args.convention, network=args.network,
-                                 domain_id=args.domain_id)
-    report = Ros2Server(options).run()
+        report = Ros2DriverStation(Ros2DriverOptions(**fields, speed_scaling=args.speed_scaling,
+                                                     distro=_distro(args), network=args.network,
+                                                     domain_id=args.domain_id)).run()
+    else:
+        from ur3hanoi.interface.ros2.server import Ros2Server, Ros2ServerOptions
+
+        options = Ros2ServerOptions(**fields, timing=args.timing, convention=args.convention, network=args.network,
+                                    domain_id=args.domain_id)
+        report = Ros2Server(options).run()
     if report_file is not None:
         print(remote.stopped_line("ros2-station", report, f"report {args.report}"), flush=True)
     return 0
@@ -93,6 +118,8 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
         f"station calibration: the table's source and the home pose (default {DEFAULT_ROS2_CALIBRATION})",
         ("; the course bridge ignores it", "; ignored by the bridge"), 1.0)
     add_dds_options(p)
+    driver.add_driver_option(p, station=False)
+    add_distro_option(p)
     remote.add_json_option(p)
     p.set_defaults(func=_run_solve)
 
@@ -102,7 +129,15 @@ def _run_solve(args: argparse.Namespace) -> int:
     from ur3hanoi.interface.ros2.client import Ros2Arm, Ros2ArmConfig
     from ur3hanoi.interface.ros2.dds import domain_id_from_env
 
-    job = remote.solve_job(args, "ros2-solve", DEFAULT_ROS2_CALIBRATION, station_optional=False)
+    job = remote.solve_job(args, "ros2-solve", DEFAULT_ROS2_CALIBRATION, station_optional=args.driver == "course")
+    if args.driver == "ur":
+        from ur3hanoi.interface.ros2.ur_client import RclpyDriverTransport
+
+        plan = driver.driver_plan(args, job, DEFAULT_ROS2_CALIBRATION)
+        transport = RclpyDriverTransport(_distro(args), args.domain_id, args.network)
+        outcome_ur: dict[str, object] = {"start": job.start + 1, "end": job.end + 1, "blocks": job.n_blocks,
+                                         "ros_distro": transport.distro, "network": args.network}
+        return driver.run_driver_solve_command(args, "ros2-solve", transport, plan, outcome_ur)
     try:
         domain = domain_id_from_env() if args.domain_id is None else args.domain_id
     except ValueError as exc:

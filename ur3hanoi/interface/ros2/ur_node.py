@@ -9,13 +9,14 @@ feedback's ``index``), else one line says which and how to get the other.
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import time
 from typing import TYPE_CHECKING, Any
 
 from ur3hanoi.interface.ros2.errors import RclpyUnavailableError
 from ur3hanoi.interface.ros2.rclpy_env import ROS_DISTROS, import_interfaces, import_rclpy
-from ur3hanoi.interface.ros2.ur_driver import io_to_msg, set_duration
+from ur3hanoi.interface.ros2.ur_driver import IoStatesMessage, set_duration
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1_JOINT_STATE_ORDER
 
 if TYPE_CHECKING:
@@ -77,10 +78,10 @@ class DriverNode:
                 station.cancel(handle)
                 return CancelResponse.ACCEPT
 
-            self.server = ActionServer(node, action.FollowJointTrajectory, names.follow_joint_trajectory,
-                                       lambda h: station.execute(h, action), goal_callback=goal_cb,
-                                       handle_accepted_callback=accepted_cb, cancel_callback=cancel_cb,
-                                       callback_group=group)
+            fjt = action.FollowJointTrajectory
+            self.server = ActionServer(node, fjt, names.follow_joint_trajectory, lambda h: station.execute(h, fjt),
+                                       goal_callback=goal_cb, handle_accepted_callback=accepted_cb,
+                                       cancel_callback=cancel_cb, callback_group=group)
 
             def set_io(request: Any, response: Any) -> Any:
                 response.success = station.serve_set_io(int(request.fun), int(request.pin), float(request.state),
@@ -101,6 +102,8 @@ class DriverNode:
             self.rclpy.try_shutdown(context=self.context)
             raise
         self._order = [CONTROLLER_JOINTS.index(j) for j in JOINT_STATE_ORDER]
+        self._io = IoStatesMessage(ur_msg)
+        self._js = sensor_msgs.JointState(name=list(JOINT_STATE_ORDER))
         self._next_scaling = self._next_feedback = 0.0
 
     def _now(self) -> float:
@@ -113,14 +116,13 @@ class DriverNode:
 
         st, out = self.station, self.station.output
         stamp = self.clock.now().to_msg()
-        js = self.sensor_msgs.JointState()
+        js = self._js
         js.header.stamp = stamp
-        js.name = list(JOINT_STATE_ORDER)
         js.position = [float(out.q[i]) for i in self._order]
         js.velocity = [float(out.qd[i]) for i in self._order]
         js.effort = [float(out.effort[i]) for i in self._order]
         self.pub_joints.publish(js)
-        self.pub_io.publish(io_to_msg(out.io, self.ur_msg))
+        self.pub_io.publish(self._io.update(out.io))
         now = time.monotonic()
         if now >= self._next_scaling:
             self._next_scaling = now + 1.0 / SPEED_SCALING_HZ
@@ -149,10 +151,8 @@ class DriverNode:
         msg.error.positions, msg.error.velocities = list(map(float, fb.error_q)), list(map(float, fb.error_qd))
         for point in (msg.desired, msg.actual, msg.error):
             set_duration(point.time_from_start, 0.0)
-        try:
+        with contextlib.suppress(Exception):  # the goal ended meanwhile (rclpy refuses feedback of a terminal goal)
             goal.handle.publish_feedback(msg)
-        except Exception:  # the goal ended meanwhile (rclpy refuses feedback of a terminal goal)
-            pass
 
     def close(self) -> None:
         """Stop the executor, destroy the node, shut the context down (every exit path)."""
