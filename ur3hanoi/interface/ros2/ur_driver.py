@@ -137,8 +137,8 @@ class IoStatesMessage:
             if last is None or getattr(last, field) != values:
                 for item, value in zip(items, values, strict=True):
                     item.state = bool(value)
-        for items, values in ((m.analog_in_states, io.analog_in), (m.analog_out_states, io.analog_out)):
-            for item, (domain, value) in zip(items, values, strict=True):
+        for items, analog in ((m.analog_in_states, io.analog_in), (m.analog_out_states, io.analog_out)):
+            for item, (domain, value) in zip(items, analog, strict=True):
                 item.domain, item.state = domain, float(value)
         self._last = io
         return m
