@@ -135,8 +135,8 @@ class IoStatesMessage:
         for field, items, values in (("digital_in", m.digital_in_states, io.digital_in),
                                      ("digital_out", m.digital_out_states, io.digital_out)):
             if last is None or getattr(last, field) != values:
-                for item, value in zip(items, values, strict=True):
-                    item.state = bool(value)
+                for item, on in zip(items, values, strict=True):
+                    item.state = bool(on)
         for items, analog in ((m.analog_in_states, io.analog_in), (m.analog_out_states, io.analog_out)):
             for item, (domain, value) in zip(items, analog, strict=True):
                 item.domain, item.state = domain, float(value)
