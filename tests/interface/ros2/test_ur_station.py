@@ -31,16 +31,26 @@ JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_j
           "wrist_3_joint"]
 
 
-def _script(env: PeerEnv, tmp_path: Path, station_args: str, *peers: str) -> str:
-    """Start the station (ur3hanoi's own Python with what ``ros2-env`` sets), wait for its ready line, run the
-    peers one after another (each prints one JSON line into ``peer<i>.json``), stop it with SIGINT."""
+def _script(env: PeerEnv, tmp_path: Path, station_args: str, *peers: str, background: str = "") -> str:
+    """Start the station (ur3hanoi's own Python with what ``ros2-env`` sets), wait for its ready line, start
+    ``background`` (output in ``bg.out``/``bg.err``), run the peers one after another (each prints one JSON line into
+    ``peer<i>.json``), stop the background process and the station with SIGINT; exit with the first failing peer's
+    code."""
     lines = [f"{env.station_prefix()} $UR3HANOI ros2-station --driver ur {station_args} --report {tmp_path}/report.json"
              f" > {tmp_path}/st.out 2> {tmp_path}/st.err &", "ST=$!", f"wait_ready {tmp_path}/st.out || exit 90",
              "CODE=0"]
+    if background:
+        lines += [f"{background} > {tmp_path}/bg.out 2> {tmp_path}/bg.err &", "BG=$!"]
     for i, peer in enumerate(peers):
-        lines.append(f"{peer} > {tmp_path}/peer{i}.json 2> {tmp_path}/peer{i}.err || CODE=$?")
+        lines.append(f"{peer} > {tmp_path}/peer{i}.json 2> {tmp_path}/peer{i}.err || CODE=${{CODE/#0/$?}}")
+    if background:
+        lines.append("kill -INT $BG; wait $BG")
     lines += ["kill -INT $ST; wait $ST; echo \"station exit $?\" >&2", "exit $CODE"]
     return "\n".join(lines) + "\n"
+
+
+def _errors(tmp_path: Path) -> str:
+    return "".join(f"--- {p.name}\n{p.read_text()}" for p in sorted(tmp_path.glob("*.err")))
 
 
 def _json(path: Path) -> dict[str, Any]:
@@ -57,8 +67,7 @@ def jazzy_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any],
                      env.peer_command(str(SUPPORT / "ur_driver_examples.py"), home, action),
                      env.peer_command(str(SUPPORT / "moveit_style_client.py"), home, action, "2.0"))
     result = in_netns(script, 240.0, REPO)
-    errors = "".join((tmp / f).read_text() for f in ("st.err", "peer0.err", "peer1.err") if (tmp / f).exists())
-    assert result.returncode == 0, result.stderr + errors
+    assert result.returncode == 0, result.stderr + _errors(tmp)
     assert "station exit 0" in result.stderr
     return _json(tmp / "peer0.json"), _json(tmp / "peer1.json"), json.loads((tmp / "report.json").read_text())
 
@@ -123,17 +132,17 @@ def test_enme480_bridge_on_the_driver_interface_solves_one_block(tmp_path: Path)
     assert cli.main(["tables", "ur3e_sim", "--key", "sim_pos", "-o", str(table), "--convention", "course"]) == 0
     home_course = ",".join(repr(float(x)) for x in from_controller(np.array(HOME), "course"))
     bridge = env.peer_command(str(SUPPORT / "enme480_ur_bridge.py"), names_for("kilted").follow_joint_trajectory)
-    student = env.peer_command(str(SUPPORT / "enme480_student.py"), str(table), "1", "3", home_course)
-    script = _script(env, tmp_path, "--blocks 1 --ros-distro kilted",
-                     f"({bridge} > {tmp_path}/bridge.out 2> {tmp_path}/bridge.err & echo $! > {tmp_path}/bridge.pid)",
-                     f"{student}; S=$?; kill -INT $(cat {tmp_path}/bridge.pid); exit $S")
+    student = env.peer_command(str(SUPPORT / "enme480_student.py"), str(table), "1", "3", home_course, "1")
+    # 125 Hz: the bridge (C++ on a lab PC) and the student are Python here, and at the UR3e's 500 Hz joint states the
+    # three processes need more than the two cores a CI machine has.
+    script = _script(env, tmp_path, "--blocks 1 --ros-distro kilted --rate 125", student, background=bridge)
     result = in_netns(script, 300.0, REPO)
-    errors = "".join((tmp_path / f).read_text() for f in ("st.err", "bridge.err", "peer1.err"))
-    assert result.returncode == 0, result.stderr + errors
+    assert result.returncode == 0, result.stderr + _errors(tmp_path)
+    assert "station exit 0" in result.stderr
     r = json.loads((tmp_path / "report.json").read_text())
     assert [(b["block"], b["tower"], b["height"]) for b in r["final"]["blocks"]] == [(1, 3, 1)]
     assert r["final"]["at_home"] and not r["final"]["suction_on"]
-    assert r["goals"]["rejected"] == 0 and r["goals"]["aborted"] == 0 and r["goals"]["succeeded"] >= 6
+    assert r["goals"]["rejected"] == 0 and r["goals"]["aborted"] == 0 and r["goals"]["succeeded"] == 10
 
 
 if __name__ == "__main__":
