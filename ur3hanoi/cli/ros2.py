@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 
 from ur3hanoi.cli import driver, remote
+from ur3hanoi.cli.options import DRIVER_WAIT, option
 
 DEFAULT_ROS2_CALIBRATION = "ur3e_sim"
 _DOMAIN_HELP = "ROS_DOMAIN_ID, 0..232 (default: $ROS_DOMAIN_ID, else 0)"
@@ -78,7 +79,7 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
 
 def add_distro_option(p: argparse.ArgumentParser) -> None:
     """``--ros-distro``: the UR driver's names and controller rules (with ``--driver ur``)."""
-    from ur3hanoi.interface.ros2.rclpy_env import ROS_DISTROS
+    from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 
     p.add_argument("--ros-distro", choices=list(ROS_DISTROS), default=None, metavar="DISTRO",
                    help="with --driver ur: the robot's ROS 2 distribution, humble, jazzy, kilted (the scaled "
@@ -87,7 +88,7 @@ def add_distro_option(p: argparse.ArgumentParser) -> None:
 
 
 def _distro(args: argparse.Namespace) -> str:
-    from ur3hanoi.interface.ros2.rclpy_env import default_distro
+    from ur3hanoi.interface.ros2.distros import default_distro
 
     return str(args.ros_distro or default_distro())
 
@@ -96,7 +97,10 @@ def _run_station(args: argparse.Namespace) -> int:
     report_file = remote.check_station_outputs(args, DEFAULT_ROS2_CALIBRATION)  # before any work
     fields = remote.station_options(args, DEFAULT_ROS2_CALIBRATION, report_file)
     if args.driver == "ur":
+        from ur3hanoi.interface.ros2.rclpy_env import import_rclpy
         from ur3hanoi.interface.ros2.ur_station import Ros2DriverOptions, Ros2DriverStation
+
+        import_rclpy()  # say what is missing before loading the world
 
         report = Ros2DriverStation(Ros2DriverOptions(**fields, speed_scaling=args.speed_scaling,
                                                      distro=_distro(args), network=args.network,
@@ -120,6 +124,9 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
     add_dds_options(p)
     driver.add_driver_option(p, station=False)
     add_distro_option(p)
+    p.add_argument("--wait", type=option(DRIVER_WAIT), default=10.0, metavar="S",
+                   help="with --driver ur: how long to wait for the driver's joint states, io_states, action server "
+                        "and set_io service (default 10 s)")
     remote.add_json_option(p)
     p.set_defaults(func=_run_solve)
 
@@ -131,10 +138,12 @@ def _run_solve(args: argparse.Namespace) -> int:
 
     job = remote.solve_job(args, "ros2-solve", DEFAULT_ROS2_CALIBRATION, station_optional=args.driver == "course")
     if args.driver == "ur":
+        from ur3hanoi.interface.ros2.rclpy_env import import_rclpy
         from ur3hanoi.interface.ros2.ur_client import RclpyDriverTransport
 
+        import_rclpy()  # say what is missing before planning
+        transport = RclpyDriverTransport(_distro(args), args.domain_id, args.network, args.wait)
         plan = driver.driver_plan(args, job, DEFAULT_ROS2_CALIBRATION)
-        transport = RclpyDriverTransport(_distro(args), args.domain_id, args.network)
         outcome_ur: dict[str, object] = {"start": job.start + 1, "end": job.end + 1, "blocks": job.n_blocks,
                                          "ros_distro": transport.distro, "network": args.network}
         return driver.run_driver_solve_command(args, "ros2-solve", transport, plan, outcome_ur)
@@ -161,7 +170,7 @@ _ENV_DESCRIPTION = (
 
 
 def _add_env(sub: argparse._SubParsersAction) -> None:
-    from ur3hanoi.interface.ros2.rclpy_env import ROS_DISTROS
+    from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 
     p = sub.add_parser("ros2-env", help="build rclpy and the UR driver's messages once, print the environment to eval",
                        description=_ENV_DESCRIPTION)
@@ -175,8 +184,8 @@ def _run_env(args: argparse.Namespace) -> int:
     import sys
     from pathlib import Path
 
+    from ur3hanoi.interface.ros2.distros import ROS_DISTROS, default_distro
     from ur3hanoi.interface.ros2.rclpy_build import WHEELS, ensure_env
-    from ur3hanoi.interface.ros2.rclpy_env import ROS_DISTROS, default_distro
     from ur3hanoi.io.cache import cache_dir
 
     distro = args.distro or default_distro()

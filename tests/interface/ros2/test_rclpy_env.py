@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from ur3hanoi.interface.ros2 import rclpy_env
+from ur3hanoi.interface.ros2 import distros, rclpy_env
 from ur3hanoi.interface.ros2.errors import RclpyUnavailableError
 from ur3hanoi.interface.ros2.rclpy_env import ENV_VAR, RclpyEnv, write_manifest
 
@@ -90,4 +90,4 @@ def test_shell_lines_set_what_variables_say(tmp_path: Path) -> None:
                                                  ("", "jazzy")])
 def test_default_distro_follows_ros_distro(value: str, expected: str, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("ROS_DISTRO", value)
-    assert rclpy_env.default_distro() == expected
+    assert distros.default_distro() == expected

@@ -33,20 +33,6 @@ ENV_VAR = "UR3HANOI_ROS2_ENV"
 MANIFEST = "manifest.json"
 FORMAT = 1
 
-ROS_DISTROS: dict[str, str] = {"humble": "jazzy", "jazzy": "jazzy", "kilted": "kilted", "lyrical": "kilted"}
-"""A robot's ROS 2 distribution -> its FollowJointTrajectory layout and the PyPI wheels that talk to it: Humble
-(control_msgs 4.x) and Jazzy (5.x) share a layout; Kilted and later (>= 6.3.0) add the feedback's ``index``."""
-
-DEFAULT_DISTRO = "jazzy"
-"""Without ``$ROS_DISTRO``: the current long-term ROS 2 release."""
-
-
-def default_distro() -> str:
-    """``$ROS_DISTRO`` when it names one of :data:`ROS_DISTROS` (a sourced installation sets it), else jazzy."""
-    distro = os.environ.get("ROS_DISTRO", "")
-    return distro if distro in ROS_DISTROS else DEFAULT_DISTRO
-
-
 def _this_python() -> str:
     return f"{sys.version_info[0]}.{sys.version_info[1]}"
 

@@ -24,7 +24,8 @@ import time
 from typing import Any
 
 from ur3hanoi.errors import DriverError, InputError
-from ur3hanoi.interface.ros2.rclpy_env import ROS_DISTROS, import_interfaces, import_rclpy
+from ur3hanoi.interface.ros2.distros import ROS_DISTROS
+from ur3hanoi.interface.ros2.rclpy_env import import_interfaces, import_rclpy
 from ur3hanoi.interface.ros2.ur_driver import goal_to_msg, io_from_msg, joint_positions, names_for
 from ur3hanoi.interface.urdriver.client import DriverState, GoalResult
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
@@ -122,7 +123,11 @@ class RclpyDriverTransport:
             os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
         self._rclpy, self._action = rclpy, action
         self.context = rclpy.Context()
-        rclpy.init(context=self.context, **({} if self.domain_id is None else {"domain_id": self.domain_id}))
+        from rclpy.signals import SignalHandlerOptions
+
+        # ur3hanoi's own handlers turn SIGINT/SIGTERM into its clean-up (the running goal canceled).
+        rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO,
+                   **({} if self.domain_id is None else {"domain_id": self.domain_id}))
         self._started = True
         self.where = f"ROS_DOMAIN_ID {self.context.get_domain_id()} ({self.network}, {self.distro})"
         node = self.node = rclpy.create_node("ur3hanoi_solve", context=self.context)

@@ -14,8 +14,9 @@ import threading
 import time
 from typing import TYPE_CHECKING, Any
 
+from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 from ur3hanoi.interface.ros2.errors import RclpyUnavailableError
-from ur3hanoi.interface.ros2.rclpy_env import ROS_DISTROS, import_interfaces, import_rclpy
+from ur3hanoi.interface.ros2.rclpy_env import import_interfaces, import_rclpy
 from ur3hanoi.interface.ros2.ur_driver import IoStatesMessage, set_duration
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1_JOINT_STATE_ORDER
 
@@ -56,7 +57,10 @@ class DriverNode:
         self.sensor_msgs, self.std_msgs = sensor_msgs, std_msgs
         self.context = rclpy.Context()
         kwargs = {} if opts.domain_id is None else {"domain_id": opts.domain_id}
-        rclpy.init(context=self.context, **kwargs)
+        from rclpy.signals import SignalHandlerOptions
+
+        # The station's own handlers stop the loop (SIGINT, SIGTERM) and write the report (SIGUSR1).
+        rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO, **kwargs)
         try:
             self.domain_id = self.context.get_domain_id()
             self.node = node = rclpy.create_node("ur3hanoi_ur_driver", context=self.context)

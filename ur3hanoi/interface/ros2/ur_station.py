@@ -90,7 +90,7 @@ class Ros2DriverStation(DriverStation):
 
     def __init__(self, options: Ros2DriverOptions, out: Callable[[str], None] | None = None,
                  log: Callable[[str], None] | None = None) -> None:
-        from ur3hanoi.interface.ros2.rclpy_env import ROS_DISTROS
+        from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 
         if options.distro not in ROS_DISTROS:
             raise InputError(f"ROS 2 distribution {options.distro!r} is invalid: expected one of "
