@@ -162,8 +162,8 @@ class RclpyDriverTransport:
             time.sleep(0.05)
         missing = self._missing()
         if missing:
-            raise DriverError(f"no UR driver on {self.where} within {self.connect_timeout_s:g} s: no "
-                              f"{', no '.join(missing)} (is the driver running, on this ROS_DOMAIN_ID and network, "
+            raise DriverError(f"no UR driver on {self.where} within {self.connect_timeout_s:g} s: missing "
+                              f"{', '.join(missing)} (is the driver running, on this ROS_DOMAIN_ID and network, "
                               f"with --ros-distro {self.distro}'s names?)")
 
     # ----------------------------------------------------------------------------------------------- topics
