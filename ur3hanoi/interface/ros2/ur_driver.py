@@ -37,6 +37,11 @@ def names_for(distro: str) -> DriverNames:
                        speed_scaling="/speed_scaling_state_broadcaster/speed_scaling")
 
 
+FEEDBACK_HZ = 20.0
+"""The trajectory controller's ``action_monitor_rate``: feedback of the running goal [Hz]."""
+SPEED_SCALING_HZ = 100.0
+"""The speed scaling broadcaster's ``state_publish_rate`` [Hz]."""
+
 PREEMPTED_TEXT = {"humble": "Current goal cancelled due to new incoming action."}
 """The preempted goal's ``error_string`` where it differs from Jazzy's."""
 PREEMPTED_DEFAULT = "Current goal preempted by new incoming action."

@@ -12,16 +12,38 @@ from __future__ import annotations
 import contextlib
 import threading
 import time
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any, Protocol
 
 from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 from ur3hanoi.interface.ros2.errors import RclpyUnavailableError
 from ur3hanoi.interface.ros2.rclpy_env import import_interfaces, import_rclpy
-from ur3hanoi.interface.ros2.ur_driver import IoStatesMessage, set_duration
-from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1_JOINT_STATE_ORDER
+from ur3hanoi.interface.ros2.ur_driver import FEEDBACK_HZ, SPEED_SCALING_HZ, IoStatesMessage, set_duration
+from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1_JOINT_STATE_ORDER, DriverNames
+from ur3hanoi.interface.urdriver.station import CycleOutput, DriverStationOptions
 
-if TYPE_CHECKING:
-    from ur3hanoi.interface.ros2.ur_station import Ros2DriverStation
+
+class Served(Protocol):
+    """What the node serves (:class:`~ur3hanoi.interface.ros2.ur_station.Ros2DriverStation`): the options, names and
+    last cycle's output, and the callbacks the node's threads call."""
+
+    @property
+    def options(self) -> DriverStationOptions: ...
+    @property
+    def names(self) -> DriverNames: ...
+    @property
+    def output(self) -> CycleOutput: ...
+    def goal_callback(self, request: Any, now_s: float) -> bool: ...
+    def accepted(self, handle: Any, now_s: float) -> None: ...
+    def execute(self, handle: Any, action: Any) -> Any: ...
+    def cancel(self, handle: Any) -> None: ...
+    def serve_set_io(self, fun: int, pin: int, state: float, sleep: Callable[[float], None]) -> bool: ...
+    def goal_handle(self, key: Any) -> Any: ...
+    def settle(self) -> None: ...
+    def on_spawn(self, tower: Any) -> None: ...
+    def on_remove(self, block: Any) -> None: ...
+    def on_hold(self, seconds: float) -> None: ...
+
 
 JOINT_STATE_ORDER = ROS1_JOINT_STATE_ORDER
 """The order of the published ``/joint_states``: none is guaranteed on ROS 2; this one breaks a client that indexes
@@ -43,7 +65,7 @@ def check_layout(action: Any, distro: str) -> None:
 class DriverNode:
     """The node (see the module docstring); :meth:`publish` once per control cycle, :meth:`close` at the end."""
 
-    def __init__(self, station: Ros2DriverStation) -> None:
+    def __init__(self, station: Served, distro: str, domain_id: int | None) -> None:
         rclpy = import_rclpy()
         action, ur_srv, ur_msg, sensor_msgs, std_msgs = import_interfaces(
             "control_msgs.action", "ur_msgs.srv", "ur_msgs.msg", "sensor_msgs.msg", "std_msgs.msg")
@@ -51,12 +73,11 @@ class DriverNode:
         from rclpy.callback_groups import ReentrantCallbackGroup
         from rclpy.executors import MultiThreadedExecutor
 
-        opts = station.options
-        check_layout(action, opts.distro)
+        check_layout(action, distro)
         self.station, self.rclpy, self.action, self.ur_msg = station, rclpy, action, ur_msg
         self.sensor_msgs, self.std_msgs = sensor_msgs, std_msgs
         self.context = rclpy.Context()
-        kwargs = {} if opts.domain_id is None else {"domain_id": opts.domain_id}
+        kwargs = {} if domain_id is None else {"domain_id": domain_id}
         from rclpy.signals import SignalHandlerOptions
 
         # The station's own handlers stop the loop (SIGINT, SIGTERM) and write the report (SIGUSR1).
@@ -116,8 +137,6 @@ class DriverNode:
     def publish(self) -> None:
         """One control cycle's messages: joint states and ``io_states`` every cycle, speed scaling at 100 Hz, the
         running goal's feedback at 20 Hz; then the goals decided or ended this cycle are settled."""
-        from ur3hanoi.interface.ros2.ur_station import FEEDBACK_HZ, SPEED_SCALING_HZ
-
         st, out = self.station, self.station.output
         stamp = self.clock.now().to_msg()
         js = self._js
@@ -135,12 +154,12 @@ class DriverNode:
         if out.feedback is not None and now >= self._next_feedback:
             self._next_feedback = now + 1.0 / FEEDBACK_HZ
             self._feedback(out.feedback, stamp)
-        st._settle()
+        st.settle()
 
     def _feedback(self, feedback: Any, stamp: Any) -> None:
         key, fb = feedback
-        goal = self.station._goals.get(key)
-        if goal is None:
+        handle = self.station.goal_handle(key)
+        if handle is None:
             return
         msg = self.action.FollowJointTrajectory.Feedback()
         msg.header.stamp = stamp
@@ -156,7 +175,7 @@ class DriverNode:
         for point in (msg.desired, msg.actual, msg.error):
             set_duration(point.time_from_start, 0.0)
         with contextlib.suppress(Exception):  # the goal ended meanwhile (rclpy refuses feedback of a terminal goal)
-            goal.handle.publish_feedback(msg)
+            handle.publish_feedback(msg)
 
     def close(self) -> None:
         """Stop the executor, destroy the node, shut the context down (every exit path)."""

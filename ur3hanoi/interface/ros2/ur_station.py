@@ -48,10 +48,6 @@ NODE_NAME = "ur3hanoi_ur_driver"
 SET_IO_POLL_S = 0.05
 SET_IO_RETRIES = 10
 """The GPIO controller's check of a write: every 50 ms, ``check_io_successfull_retries`` = 10 times."""
-FEEDBACK_HZ = 20.0
-"""``action_monitor_rate``."""
-SPEED_SCALING_HZ = 100.0
-"""The speed scaling broadcaster's ``state_publish_rate``."""
 NETWORKS = ("loopback", "lab")
 
 
@@ -168,7 +164,13 @@ class Ros2DriverStation(DriverStation):
             goal.outcome = outcome
             goal.ended.set()
 
-    def _settle(self) -> None:
+    def goal_handle(self, key: Hashable) -> Any:
+        """The rclpy handle of goal ``key`` while it waits for its end, else None."""
+        with self._lock:
+            goal = self._goals.get(key)
+        return None if goal is None else goal.handle
+
+    def settle(self) -> None:
         """The decisions and results of the last cycle to the waiting goals (a goal the follower refused after
         send_goal, e.g. one ending in the past, aborts with its code)."""
         out = self.output
@@ -214,7 +216,7 @@ class Ros2DriverStation(DriverStation):
         if self.options.network == "loopback":
             os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
         with self.signals(), self.rendering():
-            node = DriverNode(self)
+            node = DriverNode(self, self.options.distro, self.options.domain_id)
             try:
                 self.domain_id = node.domain_id
                 self.loop(self._ready_line(), lambda: None, node.publish)
