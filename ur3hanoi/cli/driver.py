@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from ur3hanoi.cli.options import SPEED_SLIDER, option
+from ur3hanoi.cli.options import DRIVER_WAIT, SPEED_SLIDER, option
 
 if TYPE_CHECKING:
     from ur3hanoi.cli.remote import SolveJob
@@ -39,6 +40,9 @@ def add_driver_option(p: argparse.ArgumentParser, station: bool) -> None:
         p.add_argument("--far-start", choices=("approach", "refuse"), default="approach",
                        help="with --driver ur, an arm far from where the plan starts: approach = move it there "
                             "first at 25 %% speed (default), refuse = stop with the distance")
+        p.add_argument("--wait", type=option(DRIVER_WAIT), default=15.0, metavar="S",
+                       help="with --driver ur: wait at most S seconds for the driver's joint states, io_states, "
+                            "action server and set_io (default 15)")
 
 
 def driver_plan(args: argparse.Namespace, job: SolveJob, default_calibration: str) -> Plan:
@@ -53,10 +57,11 @@ def driver_plan(args: argparse.Namespace, job: SolveJob, default_calibration: st
     return plan_solve(station, job.start, job.end, job.n_blocks, PlanConfig())
 
 
-def run_driver_solve_command(args: argparse.Namespace, command: str, transport: Any, plan: Plan,
+def run_driver_solve_command(args: argparse.Namespace, transport: Any, make_plan: Callable[[], Plan],
                              outcome: dict[str, object]) -> int:
-    """Connect ``transport``, run the plan, print the outcome (one JSON object with ``--json``); a suction fault is
-    re-raised (exit 3) after its outcome is printed; every other error propagates (exit 2)."""
+    """Connect ``transport`` (no driver: an error at once, before planning), plan, run the plan, print the outcome
+    (one JSON object with ``--json``); a suction fault is re-raised (exit 3) after its outcome is printed; every
+    other error propagates (exit 2)."""
     import json
 
     from ur3hanoi.cli.remote import say_for
@@ -65,9 +70,10 @@ def run_driver_solve_command(args: argparse.Namespace, command: str, transport: 
 
     say = say_for(args)
     config = DriverSolveConfig(grasp_timeout_s=args.grasp_timeout, far_start=args.far_start)
-    outcome.update(driver="ur", plan_duration_s=round(plan.duration_s, 3))
     try:
         transport.connect()
+        plan = make_plan()
+        outcome.update(driver="ur", plan_duration_s=round(plan.duration_s, 3))
         say(f"connected to the UR driver on {transport.where}: {len(plan.moves)} moves, plan {plan.duration_s:.1f} s")
         try:
             result = run_driver_solve(transport, plan, plan.station.wiring, config, log=say)

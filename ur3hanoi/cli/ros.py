@@ -131,9 +131,9 @@ def _run_solve(args: argparse.Namespace) -> int:
     if args.driver == "ur":
         from ur3hanoi.interface.ros1.ur_client import RosDriverTransport
 
-        plan = driver.driver_plan(args, job, DEFAULT_CALIBRATION)
         outcome_ur: dict[str, object] = {"start": job.start + 1, "end": job.end + 1, "blocks": job.n_blocks}
-        return driver.run_driver_solve_command(args, "ros-solve", RosDriverTransport(args.master), plan, outcome_ur)
+        return driver.run_driver_solve_command(args, RosDriverTransport(args.master, args.wait),
+                                               lambda: driver.driver_plan(args, job, DEFAULT_CALIBRATION), outcome_ur)
     arm = RosArm(ArmConfig(v=args.v, a=args.a), master_uri=args.master, log=remote.say_for(args))
     outcome: dict[str, object] = {"start": job.start + 1, "end": job.end + 1, "blocks": job.n_blocks, "v": args.v,
                                   "a": args.a}

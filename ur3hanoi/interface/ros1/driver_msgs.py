@@ -18,7 +18,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from ur3hanoi.interface.ros1.env import ensure_ros_python
+from ur3hanoi.interface.ros1.env import ensure_driver_python
 from ur3hanoi.interface.ros1.errors import RosError
 
 TEXTS = Path(__file__).resolve().parent / "driver_texts"
@@ -97,15 +97,10 @@ def _split_full_text(main_type: str, full_text: str) -> dict[str, str]:
 
 def _debian_texts() -> dict[str, str]:
     """The texts of the messages Debian packages (from its generated classes)."""
-    ensure_ros_python()
     texts: dict[str, str] = {}
     for module, name in (("trajectory_msgs.msg", "JointTrajectory"), ("actionlib_msgs.msg", "GoalStatus"),
                          ("actionlib_msgs.msg", "GoalID")):
-        try:
-            cls = getattr(importlib.import_module(module), name)
-        except ImportError:
-            raise RosError(f"{module} is not importable: install Debian's python3-trajectory-msgs and "
-                           "python3-actionlib-msgs (bash tools/ensure-system-deps.sh)") from None
+        cls = getattr(importlib.import_module(module), name)
         texts.update(_split_full_text(cls._type, cls._full_text))
     return texts
 
@@ -152,8 +147,13 @@ def _checked(name: str, cls: Any) -> Any:
 
 @cache
 def load_driver_messages() -> DriverMessages:
-    """The classes, generated once and checked against :data:`OFFICIAL_MD5`."""
-    ensure_ros_python()
+    """The classes, generated once and checked against :data:`OFFICIAL_MD5`.
+
+    Raises:
+        RosUnavailableError: Debian's packages of the driver's interface are missing (named).
+        RosError: a class does not have its official md5sum.
+    """
+    ensure_driver_python()
     texts = _debian_texts()
     texts.update(action_texts(FJT, (TEXTS / "control_msgs" / "FollowJointTrajectory.action").read_text()))
     texts["control_msgs/JointTolerance"] = (TEXTS / "control_msgs" / "JointTolerance.msg").read_text()

@@ -32,7 +32,10 @@ class GoalResult:
     error_string: str = ""
 
     def describe(self) -> str:
-        """``aborted: PATH_TOLERANCE_VIOLATED (-4) "shoulder_pan_joint path error 0.2"``."""
+        """``aborted: PATH_TOLERANCE_VIOLATED (-4) "shoulder_pan_joint path error 0.2"``; a rejection without a code
+        (ROS 2 rejects at ``send_goal``) says where to look."""
+        if self.status == "rejected" and self.code is None:
+            return "rejected at send_goal (the ROS 2 driver gives no code: its log says why)"
         text = self.status if self.code is None else f"{self.status}: {code_name(self.code)}"
         return text + (f' "{self.error_string}"' if self.error_string else ' (no error string)' if self.code else "")
 

@@ -50,13 +50,15 @@ TIME_RESOLUTION_S = 1e-9
 
 @dataclass(frozen=True)
 class Outcome:
-    """How a goal ended: ``status``, the result's ``code`` and ``error_string``, at controller cycle ``cycle``."""
+    """How a goal ended: ``status``, the result's ``code`` and ``error_string``, at controller cycle ``cycle``;
+    ``max_path_error_rad``: its largest position error while its trajectory ran."""
 
     key: Hashable
     status: Status
     code: ErrorCode
     error_string: str
     cycle: int
+    max_path_error_rad: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -204,7 +206,7 @@ class TrajectoryFollower:
 
     def _end(self, status: Status, code: ErrorCode, text: str) -> None:
         assert self.active is not None
-        self._outcomes.append(Outcome(self.active.key, status, code, text, self.cycle))
+        self._outcomes.append(Outcome(self.active.key, status, code, text, self.cycle, self.active.max_path_error))
         self.active = None
 
     def take_outcomes(self) -> list[Outcome]:

@@ -111,6 +111,7 @@ class DriverRecords:
         self.counts[outcome.status] += 1
         if rec is not None:
             rec.t_end, rec.outcome = t, outcome
+            rec.max_path_error_rad = max(rec.max_path_error_rad, outcome.max_path_error_rad)
 
     def io_call(self, t: float, fun: int, pin: int, state: float, success: bool) -> None:
         self.counts["io_calls" if success else "io_refused"] += 1
