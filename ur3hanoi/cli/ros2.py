@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 
 from ur3hanoi.cli import driver, remote
-from ur3hanoi.cli.options import DRIVER_WAIT, option
 
 DEFAULT_ROS2_CALIBRATION = "ur3e_sim"
 _DOMAIN_HELP = "ROS_DOMAIN_ID, 0..232 (default: $ROS_DOMAIN_ID, else 0)"
@@ -124,9 +123,6 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
     add_dds_options(p)
     driver.add_driver_option(p, station=False)
     add_distro_option(p)
-    p.add_argument("--wait", type=option(DRIVER_WAIT), default=10.0, metavar="S",
-                   help="with --driver ur: how long to wait for the driver's joint states, io_states, action server "
-                        "and set_io service (default 10 s)")
     remote.add_json_option(p)
     p.set_defaults(func=_run_solve)
 
@@ -141,12 +137,12 @@ def _run_solve(args: argparse.Namespace) -> int:
         from ur3hanoi.interface.ros2.rclpy_env import import_rclpy
         from ur3hanoi.interface.ros2.ur_client import RclpyDriverTransport
 
-        import_rclpy()  # say what is missing before planning
+        import_rclpy()  # say what is missing before anything else
         transport = RclpyDriverTransport(_distro(args), args.domain_id, args.network, args.wait)
-        plan = driver.driver_plan(args, job, DEFAULT_ROS2_CALIBRATION)
         outcome_ur: dict[str, object] = {"start": job.start + 1, "end": job.end + 1, "blocks": job.n_blocks,
                                          "ros_distro": transport.distro, "network": args.network}
-        return driver.run_driver_solve_command(args, "ros2-solve", transport, plan, outcome_ur)
+        return driver.run_driver_solve_command(
+            args, transport, lambda: driver.driver_plan(args, job, DEFAULT_ROS2_CALIBRATION), outcome_ur)
     try:
         domain = domain_id_from_env() if args.domain_id is None else args.domain_id
     except ValueError as exc:
