@@ -28,6 +28,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from importlib.resources import files
@@ -97,7 +98,9 @@ def driver_packages(wheels: Wheels) -> tuple[MsgPackage, ...]:
 
 
 def python_version(python: str) -> str:
-    """``X.Y`` of the interpreter ``python``."""
+    """``X.Y`` of the interpreter ``python`` (this one's without starting it)."""
+    if os.path.realpath(python) == os.path.realpath(sys.executable):
+        return f"{sys.version_info[0]}.{sys.version_info[1]}"
     out = subprocess.run([python, "-c", "import sys; print('%d.%d' % sys.version_info[:2])"], capture_output=True,
                          text=True, timeout=60, check=True)
     return out.stdout.strip()
