@@ -8,8 +8,9 @@ controller's profile per distribution, and the conversions between its messages 
   ``/speed_scaling_state_broadcaster/speed_scaling`` in **percent** on every distribution.
 - The controller (ros2_controllers' ``joint_trajectory_controller.cpp``): Humble accepts a last point that still moves
   (``allow_nonzero_velocity_at_trajectory_end`` defaults to true there), Jazzy and later reject it; a new goal
-  preempts the running one with INVALID_GOAL and "Current goal preempted by new incoming action." (Humble: "Current
-  goal cancelled due to new incoming action.").
+  preempts the running one, which aborts with INVALID_GOAL and "Current goal preempted by new incoming action."
+  (Humble's controller writes "Current goal cancelled due to new incoming action." and marks it canceled, a
+  transition rclpy's server allows only after a client's cancel request: the station aborts it with Humble's text).
 
 Conversions take and return the rclpy message objects (``control_msgs``, ``ur_msgs``, ``sensor_msgs``) but import
 nothing: the binding imports them (:mod:`ur3hanoi.interface.ros2.rclpy_env`) and passes the classes in.
