@@ -4,12 +4,12 @@
 PY ?= python3
 VENV ?= .venv
 STAMP := $(VENV)/.installed
-export MUJOCO_GL ?= egl
 export NO_MKDOCS_2_WARNING ?= 1  # Material's end-of-life notice on every docs build
 
 .PHONY: solve test test-fast venv lint bench tables docs pictures clean lab
 
-$(STAMP): pyproject.toml requirements.lock tools/ensure-system-deps.sh
+# ur3hanoi/version.py: the installed metadata's version is read from it (pyproject.toml's dynamic version).
+$(STAMP): pyproject.toml requirements.lock tools/ensure-system-deps.sh ur3hanoi/version.py
 	@$(PY) -c 'import sys; ok = (3, 11) <= sys.version_info[:2] <= (3, 13); ok or print(f"ur3hanoi: error: Python {sys.version.split()[0]} ($(PY)) is not supported: use Python 3.11, 3.12 or 3.13, e.g. make PY=python3.12"); sys.exit(not ok)'
 	bash tools/ensure-system-deps.sh
 	$(PY) -m venv $(VENV)

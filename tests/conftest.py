@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import atexit
+import contextlib
 import os
 import shutil
 import tempfile
@@ -10,12 +11,18 @@ from pathlib import Path
 
 import pytest
 
+from ur3hanoi.errors import SimulationError
 from ur3hanoi.io.resources import stations_dir
+from ur3hanoi.opengl import use_platform
 from ur3hanoi.station.calibration import Station, load_station
 
-# Headless offscreen rendering. MuJoCo reads it when first imported, i.e. while the first test module importing
-# ur3hanoi.sim is collected: it must be set before any of them.
-os.environ.setdefault("MUJOCO_GL", "egl")
+# Offscreen rendering with the OpenGL platform the commands would choose on this machine (the display's, else EGL,
+# else OSMesa; a MUJOCO_GL set by the caller is kept). MuJoCo reads MUJOCO_GL when first imported, i.e. while the
+# first test module importing ur3hanoi.sim is collected: it must be set before any of them. The commands the tests
+# run inherit it, already tried (ur3hanoi.opengl.VERIFIED): they try nothing again. With no platform, the tests that
+# render fail with the one line that says why.
+with contextlib.suppress(SimulationError):
+    use_platform()
 
 # The suite has a user cache of its own (ur3hanoi.io.cache: collision geometry, plan connections), so that an entry left
 # in the user's cache by another version can never change a result, and the tests leave nothing behind there. The

@@ -13,14 +13,14 @@ import pytest
 import ur3hanoi
 
 
-@pytest.mark.parametrize("name", sorted(set(ur3hanoi.__all__) - {"__version__"}))
+@pytest.mark.parametrize("name", sorted(ur3hanoi.__all__))
 def test_each_name_is_its_home_modules_object(name: str) -> None:
     home = importlib.import_module(f"ur3hanoi.{ur3hanoi._HOME[name]}")
     assert getattr(ur3hanoi, name) is getattr(home, name)
 
 
 def test_all_lists_exactly_the_names_with_a_home() -> None:
-    assert sorted(ur3hanoi.__all__) == sorted(["__version__", *ur3hanoi._HOME])
+    assert sorted(ur3hanoi.__all__) == sorted(ur3hanoi._HOME)
 
 
 def test_an_unknown_name_is_an_attribute_error() -> None:

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # System packages the project needs outside its virtual environment, installed with apt-get when missing and we
 # are root; otherwise says what to install. Python packages from PyPI are not installed here (requirements.lock).
-#  - Headless MuJoCo rendering (MUJOCO_GL=egl: --video/--frames and the notebooks): Mesa's EGL and GL drivers.
+#  - Headless MuJoCo rendering (--video/--frames and notebook 04 choose EGL without a display, ur3hanoi/opengl.py):
+#    Mesa's EGL and GL drivers.
 #  - ROS 1 for `ur3hanoi ros-station` / `ros-solve` and their tests: Debian's roscore and pure-Python rospy,
-#    genpy and std_msgs (about 40 s). ur3hanoi.interface.ros1 appends /usr/lib/python3/dist-packages to the venv's path.
+#    genpy and std_msgs (about 40 s); for the UR driver's interface (--driver ur) also actionlib, actionlib_msgs,
+#    trajectory_msgs and sensor_msgs. ur3hanoi.interface.ros1 appends /usr/lib/python3/dist-packages to the venv's path.
 #  - Debian's chromium: the replay page's test opens it headless with the network off (tests/replay/test_page.py).
 set -euo pipefail
 missing=()
@@ -18,7 +20,7 @@ command -v cmake >/dev/null || missing+=(cmake)
 command -v g++ >/dev/null || missing+=(g++)
 command -v make >/dev/null || missing+=(make)
 command -v chromium >/dev/null || missing+=(chromium)
-for pkg in rospy genpy std_msgs; do
+for pkg in rospy genpy std_msgs actionlib actionlib_msgs trajectory_msgs sensor_msgs; do
   [ -e "/usr/lib/python3/dist-packages/$pkg/__init__.py" ] || missing+=("python3-${pkg//_/-}")
 done
 [ ${#missing[@]} -eq 0 ] && exit 0

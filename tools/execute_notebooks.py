@@ -20,7 +20,6 @@ REPO = Path(__file__).resolve().parents[1]
 
 def execute(nb: nbformat.NotebookNode, directory: Path) -> nbformat.NotebookNode:
     """Run every cell of ``nb`` in a fresh kernel (matplotlib's inline backend: figures become PNG outputs)."""
-    os.environ.setdefault("MUJOCO_GL", "egl")
     # The kernel's inline backend, not Agg: the figures are the outputs (the caller's setting is restored).
     saved = os.environ.pop("MPLBACKEND", None)
     try:

@@ -17,8 +17,6 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
-
 if TYPE_CHECKING:
     from ur3hanoi.audit import audit_table
     from ur3hanoi.calibrate import fit_station
@@ -36,6 +34,7 @@ if TYPE_CHECKING:
     from ur3hanoi.station.grid import ABOVE, ON, T_base_tcp, grid_targets_world, pose_label
     from ur3hanoi.tables import read_recorded_table, read_table, write_table
     from ur3hanoi.tables.ik_table import check_table, generate_table
+    from ur3hanoi.version import __version__
 
 _HOME: dict[str, str] = {
     "audit_table": "audit", "fit_station": "calibrate",
@@ -51,6 +50,7 @@ _HOME: dict[str, str] = {
     **dict.fromkeys(("ABOVE", "ON", "T_base_tcp", "grid_targets_world", "pose_label"), "station.grid"),
     **dict.fromkeys(("read_recorded_table", "read_table", "write_table"), "tables"),
     **dict.fromkeys(("check_table", "generate_table"), "tables.ik_table"),
+    "__version__": "version",
 }
 """The module (under ``ur3hanoi.``) that defines each name of the package's own API."""
 

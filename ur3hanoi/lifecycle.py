@@ -14,6 +14,10 @@ Processes ur3hanoi starts (each stopped on its parent's every exit path: normal 
   their defaults and dies with the guard;
 - the station's rendering process (:mod:`ur3hanoi.interface.render`, ``spawn``): its pipe, SIGTERM, its parent's death;
   it ignores SIGINT on purpose (a Ctrl-C must not cut the video short: the station finishes it);
+- the OpenGL probes (:func:`ur3hanoi.opengl.probe`: a ``python -c`` that renders one frame, before a command
+  renders): waited for, killed by :func:`subprocess.run` on its timeout or on any exception (a Ctrl-C, SIGTERM
+  raised by :func:`sigterm_raises`), and dies with its parent (:func:`child_start`, its first act: no
+  ``preexec_fn``, so a threaded caller such as a Jupyter kernel may probe too);
 - ``solve --video``'s rendering workers (:class:`ur3hanoi.sim.render.OffscreenRecorder`, a ``spawn`` pool):
   ``Pool.terminate`` (SIGTERM), their parent's death; ffmpeg (imageio-ffmpeg's) ends at the end of file of its
   stdin pipe; multiprocessing's resource tracker at the end of file of its own.

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import gc
 import json
+import re
 from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
@@ -61,11 +62,15 @@ def test_the_render_sink_writes_what_the_report_counts(kind: str, tmp_path: Path
                                                        monkeypatch: pytest.MonkeyPatch) -> None:
     """ServerCore without a transport, 2 s of real time with one move of joint 1 and ``frames`` or ``video``: the
     rendering process writes as many frames as the report says it rendered (the rest dropped, not waited for),
-    the pictures are not blank and show the arm moving."""
+    the pictures are not blank and show the arm moving. Without a display or MUJOCO_GL, the process chooses its
+    OpenGL platform itself (ur3hanoi.opengl), as a script using the library would have it."""
     import imageio_ffmpeg
     from PIL import Image
 
-    monkeypatch.setenv("MUJOCO_GL", "egl")
+    from ur3hanoi.opengl import MUJOCO_GL, VERIFIED
+
+    for name in (MUJOCO_GL, VERIFIED, "DISPLAY", "WAYLAND_DISPLAY"):
+        monkeypatch.delenv(name, raising=False)
     out = tmp_path / ("run.mp4" if kind == "video" else "frames")
     node = ServerCore(ServerOptions(duration_s=2.0, **{kind: out}), out=lambda _s: None, report_out=lambda _s: None)
     q = [float(x) for x in node.world.q]
@@ -97,3 +102,19 @@ def test_the_render_sink_writes_what_the_report_counts(kind: str, tmp_path: Path
     if len(images) > 1:
         assert max(float(np.abs(im - images[0]).max()) for im in images) > 50.0  # the arm moved
     assert node.report()["frames"] == frames  # closed: the counts are final
+
+
+def test_a_station_behind_real_time_says_so() -> None:
+    """A publish step that stalls the loop 0.45 s once: one warning line naming how far behind it is."""
+    logged: list[str] = []
+    node = ServerCore(ServerOptions(duration_s=0.6), out=logged.append, report_out=lambda _s: None)
+    stalls = iter([0.45])
+
+    def publish() -> None:
+        import time
+
+        time.sleep(next(stalls, 0.0))
+
+    node.loop("ready", lambda: None, publish)
+    behind = [line for line in logged if "behind real time" in line]
+    assert len(behind) == 1 and re.match(r"loop: the station is \d+ ms behind real time: .* lower --rate", behind[0])

@@ -199,7 +199,7 @@ def test_typo_base_rpy_is_an_error_with_the_suggestion(tmp_path: Path) -> None:
     [
         ("grids", {}, "field 'grids' is unknown: did you mean 'grid'?"),
         ("colour", "red",
-         "field 'colour' is unknown: expected one of name, layout, robot, tool, blocks, grid, suction"),
+         "field 'colour' is unknown: expected one of name, layout, robot, tool, blocks, grid, suction, io"),
         ("tool.yaw", 90, "field 'tool.yaw' is unknown: did you mean 'tool.yaw_deg'?"),
         ("grid.tower_orgins", [[0, 0, 0]] * 3, "field 'grid.tower_orgins' is unknown: did you mean "
                                                "'grid.tower_origins'?"),

@@ -14,7 +14,6 @@ Usage: ``python tests/support/ros2_lifecycle_probe.py MODE DIR``; prints one JSO
 from __future__ import annotations
 
 import json
-import os
 import signal
 import subprocess
 import sys
@@ -132,7 +131,6 @@ def video(folder: Path) -> dict[str, Any]:
 
 def main() -> int:
     mode, folder = sys.argv[1], Path(sys.argv[2])
-    os.environ.setdefault("MUJOCO_GL", "egl")
     print(json.dumps(restart(folder) if mode == "restart" else video(folder)))
     return 0
 

@@ -8,7 +8,6 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ur3hanoi import __version__
 from ur3hanoi.calibrate.result import CalibrationFit
 from ur3hanoi.calibrate.taught import TaughtPoints
 from ur3hanoi.calibrate.verdict import accepted_lines
@@ -16,6 +15,7 @@ from ur3hanoi.errors import CalibrationError, TaughtPointsError, printable
 from ur3hanoi.io.atomic import atomic_write
 from ur3hanoi.io.yaml_loader import parse_yaml
 from ur3hanoi.station.calibration import Station, parse_station, station_to_dict
+from ur3hanoi.version import __version__
 
 
 def calibration_text(fit: CalibrationFit, taught: TaughtPoints, base: Station, taught_label: str | None = None,

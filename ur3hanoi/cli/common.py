@@ -4,9 +4,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ur3hanoi.errors import printable
+
+if TYPE_CHECKING:
+    from ur3hanoi.opengl import Choice
 
 DEFAULT_CALIBRATION = "lab_sim"
 
@@ -25,17 +28,25 @@ def input_file(ref: str) -> Path:
     return station_file(ref)
 
 
-def check_render_outputs(video: str | None, frames: str | None, inputs: Sequence[Path] = ()) -> None:
+def check_render_outputs(video: str | None, frames: str | None, inputs: Sequence[Path] = ()) -> Choice | None:
     """Refuse a ``--video`` file or ``--frames`` folder that cannot be written, before any work (the rules of
-    :mod:`ur3hanoi.io.atomic`). Imports MuJoCo (set ``MUJOCO_GL`` first)."""
+    :mod:`ur3hanoi.io.atomic`), and choose the OpenGL platform to render with (:func:`ur3hanoi.opengl.use_platform`,
+    before MuJoCo is imported: call this first). Returns the choice (None: nothing to render)."""
     from ur3hanoi.io.atomic import check_output, check_output_dir
-    from ur3hanoi.sim.render import check_video_path
+    from ur3hanoi.opengl import use_platform
 
     if video:
         check_output(video, inputs=inputs)  # first: "it is a directory" says more than "no extension"
-        check_video_path(video)
     if frames:
         check_output_dir(frames, inputs=inputs)
+    if not (video or frames):
+        return None
+    choice = use_platform()
+    if video:
+        from ur3hanoi.sim.render import check_video_path  # imports MuJoCo
+
+        check_video_path(video)
+    return choice
 
 
 def shown(path: Any) -> str:

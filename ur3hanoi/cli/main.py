@@ -18,15 +18,15 @@ import warnings
 from collections.abc import Sequence
 from typing import NoReturn
 
-from ur3hanoi import __version__
 from ur3hanoi.cli import exit_codes
 from ur3hanoi.errors import Ur3HanoiError, Ur3HanoiWarning, printable
 from ur3hanoi.lifecycle import Terminated, sigterm_raises
+from ur3hanoi.version import __version__
 
 COMMAND_MODULES: dict[str, str] = {
     "tables": "tables", "check-table": "check_table", "calibrate": "calibrate", "teach": "teach", "plan": "plan",
     "solve": "solve", "ros-station": "ros", "ros-solve": "ros", "ros-env": "ros", "ros2-station": "ros2",
-    "ros2-solve": "ros2"}
+    "ros2-solve": "ros2", "ros2-env": "ros2"}
 """Each command's module in :mod:`ur3hanoi.cli`, in the order ``--help`` lists them. A run imports only its own
 command's module (the others' options cost start-up time and nothing else)."""
 ERROR_PREFIX = "ur3hanoi: error:"

@@ -52,6 +52,7 @@ CMD_ACCELERATION = Number(0.0, 20.0, lo_open=True, unit="rad/s^2",
                           what="a commanded joint acceleration (the driver caps it)")
 GRASP_TIMEOUT = Number(0.0, 10.0, lo_open=True, unit="s", what="a wait for the vacuum switch")
 DURATION = Number(0.0, 7 * 86400.0, lo_open=True, unit="s", what="a run time")
+SPEED_SLIDER = Number(0.0, 1.0, lo_open=True, what="a speed slider fraction")
 # teach.
 DRIVER_WAIT = Number(0.5, 600.0, unit="s", what="a wait for the driver")
 

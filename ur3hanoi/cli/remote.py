@@ -9,7 +9,6 @@ exit code 2; a suction fault exits with 3 (after printing the ``--json`` outcome
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -61,8 +60,9 @@ def add_station_options(p: argparse.ArgumentParser, default_calibration: str, an
     p.add_argument("--drop-on-grasp", type=option(MOVE), metavar="K",
                    help="fault injection: the block of the K-th grasp falls off during the next motion")
     p.add_argument("--seed", type=option(SEED), default=0, metavar="K", help=f"seed of the {analog} noise")
-    p.add_argument("--rate", type=option(ROS_RATE), default=125.0, metavar="HZ",
-                   help=f"control and publishing rate, 50..500 Hz, period a multiple of 2 ms (default 125{rate_note})")
+    p.add_argument("--rate", type=option(ROS_RATE), default=None, metavar="HZ",
+                   help=f"control and publishing rate, 50..500 Hz, period a multiple of 2 ms (default 125{rate_note}; "
+                        "with --driver ur the robot's control rate: 125 on a UR3, 500 on a UR3e)")
 
 
 def add_station_outputs(p: argparse.ArgumentParser) -> None:
@@ -71,16 +71,16 @@ def add_station_outputs(p: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=option(DURATION), metavar="S", help="stop by itself after S seconds")
     add_suction_profile_option(p)
     out = p.add_mutually_exclusive_group()
-    out.add_argument("--video", metavar="FILE.mp4", help="render an MP4 offscreen (headless: MUJOCO_GL=egl)")
-    out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR")
+    out.add_argument("--video", metavar="FILE.mp4",
+                     help="render an MP4 offscreen (OpenGL: the display's, else EGL, else OSMesa, or MUJOCO_GL)")
+    out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR (OpenGL as --video)")
 
 
 def check_station_outputs(args: argparse.Namespace, default_calibration: str) -> Path | None:
     """Refuse a ``--report``, ``--video`` or ``--frames`` that cannot be written (:mod:`ur3hanoi.io.atomic`), before
-    any work; returns the report file (None: standard output, also for ``--report -``). Sets ``MUJOCO_GL=egl``
-    for rendering on a machine without a display."""
-    if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
-        os.environ["MUJOCO_GL"] = "egl"  # headless offscreen rendering (read when the GL context is created)
+    any work; returns the report file (None: standard output, also for ``--report -``). With ``--video`` or
+    ``--frames``, chooses the OpenGL platform the rendering process will use (it inherits ``MUJOCO_GL``) and says
+    which on stderr."""
     from ur3hanoi.cli.common import check_render_outputs, input_file
     from ur3hanoi.io.atomic import check_output
 
@@ -88,7 +88,9 @@ def check_station_outputs(args: argparse.Namespace, default_calibration: str) ->
     report = None if args.report in (None, "-") else Path(args.report)
     if report is not None:
         check_output(report, inputs=inputs)
-    check_render_outputs(args.video, args.frames, inputs)
+    gl = check_render_outputs(args.video, args.frames, inputs)
+    if gl is not None:
+        print(f"ur3hanoi {args.command}: rendering with {gl.describe()}", file=sys.stderr, flush=True)
     return report
 
 
@@ -97,13 +99,18 @@ def station_options(args: argparse.Namespace, default_calibration: str, report: 
     return {"calibration": args.calibration or default_calibration, "start": args.start - 1,
             "n_blocks": args.blocks, "removed": None if args.remove_block is None else args.remove_block - 1,
             "drop_on_grasp": None if args.drop_on_grasp is None else args.drop_on_grasp - 1, "seed": args.seed,
-            "rate_hz": args.rate, "report": report, "duration_s": args.duration,
+            "rate_hz": args.rate if args.rate is not None or getattr(args, "driver", "course") == "ur" else 125.0,
+            "report": report, "duration_s": args.duration,
             "suction_profile": args.suction_profile, "frames": Path(args.frames) if args.frames else None,
             "video": Path(args.video) if args.video else None}
 
 
 def stopped_line(command: str, report: dict[str, Any], extra: str = "") -> str:
-    """``COMMAND stopped: N commands executed, M refused; EXTRA`` (``extra`` ends with the report file)."""
+    """``COMMAND stopped: N commands executed, M refused; EXTRA`` (``extra`` ends with the report file); with the
+    UR driver's interface ``N goals accepted, M rejected``."""
+    if "goals" in report:
+        g = report["goals"]
+        return f"{command} stopped: {g['accepted']} goals accepted, {g['rejected']} rejected; {extra}"
     c = report["commands"]
     return f"{command} stopped: {c['executed']} commands executed, {c['rejected']} refused; {extra}"
 

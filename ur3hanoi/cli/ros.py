@@ -12,9 +12,13 @@ import argparse
 import os
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from ur3hanoi.cli import remote
+from ur3hanoi.cli import driver, remote
 from ur3hanoi.cli.common import DEFAULT_CALIBRATION
+
+if TYPE_CHECKING:
+    from ur3hanoi.interface.ros1.server import RosServer
 
 _STATION_HELP = "run the MuJoCo station as the course's ROS driver (ur3/command, position, gripper_input)"
 _STATION_DESCRIPTION = (
@@ -59,17 +63,27 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
                    help="address the station and the roscore it starts listen on and advertise (ROS_IP); default "
                         "127.0.0.1: this machine only. Give this machine's lab-network address to open them to "
                         "other machines (a master on another machine needs it)")
+    driver.add_driver_option(p, station=True)
     remote.add_station_outputs(p)
     p.set_defaults(func=_run_station)
 
 
-def _run_station(args: argparse.Namespace) -> int:
-    report_file = remote.check_station_outputs(args, DEFAULT_CALIBRATION)  # before any work
+def _node(args: argparse.Namespace, report_file: Path | None) -> RosServer:
+    """The station node: the course's topics, or the UR driver's interface (``--driver ur``)."""
     from ur3hanoi.interface.ros1.server import RosServer, RosServerOptions
 
-    options = RosServerOptions(**remote.station_options(args, DEFAULT_CALIBRATION, report_file),
-                             master_uri=args.master, host=args.host)
-    node = RosServer(options)
+    fields = remote.station_options(args, DEFAULT_CALIBRATION, report_file)
+    if args.driver == "ur":
+        from ur3hanoi.interface.ros1.ur_server import RosDriverOptions, RosDriverServer
+
+        return RosDriverServer(RosDriverOptions(**fields, master_uri=args.master, host=args.host,
+                                                speed_scaling=args.speed_scaling))
+    return RosServer(RosServerOptions(**fields, master_uri=args.master, host=args.host))
+
+
+def _run_station(args: argparse.Namespace) -> int:
+    report_file = remote.check_station_outputs(args, DEFAULT_CALIBRATION)  # before any work
+    node = _node(args, report_file)
     # Standard output carries only the JSON report: whatever else writes to file descriptor 1 (rospy's info
     # handler, C libraries) goes to stderr while the node runs.
     sys.stdout.flush()
@@ -83,7 +97,9 @@ def _run_station(args: argparse.Namespace) -> int:
         sys.stdout.flush()
         os.dup2(report_fd, 1)
         os.close(report_fd)
-    if report_file is not None:
+    if report_file is not None and args.driver == "ur":
+        print(remote.stopped_line("ros-station", report, f"report {args.report}"), file=sys.stderr, flush=True)
+    elif report_file is not None:
         blocks = ", ".join(f"{b['block']} " + ("off-grid" if b["tower"] is None else
                                               f"tower {b['tower']} height {b['height']}")
                            for b in report["final"]["blocks"])
@@ -103,6 +119,7 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
         f"{DEFAULT_CALIBRATION}; with --table and no --calibration: the lab's home)",
         (", the lab's; capped by the driver", ", the lab's"), 4.0)
     p.add_argument("--master", metavar="URI", help=_master_help())
+    driver.add_driver_option(p, station=False)
     remote.add_json_option(p)
     p.set_defaults(func=_run_solve)
 
@@ -110,7 +127,13 @@ def _add_solve(sub: argparse._SubParsersAction) -> None:
 def _run_solve(args: argparse.Namespace) -> int:
     from ur3hanoi.interface.ros1.client import ArmConfig, RosArm
 
-    job = remote.solve_job(args, "ros-solve", DEFAULT_CALIBRATION, station_optional=True)
+    job = remote.solve_job(args, "ros-solve", DEFAULT_CALIBRATION, station_optional=args.driver == "course")
+    if args.driver == "ur":
+        from ur3hanoi.interface.ros1.ur_client import RosDriverTransport
+
+        outcome_ur: dict[str, object] = {"start": job.start + 1, "end": job.end + 1, "blocks": job.n_blocks}
+        return driver.run_driver_solve_command(args, RosDriverTransport(args.master, args.wait),
+                                               lambda: driver.driver_plan(args, job, DEFAULT_CALIBRATION), outcome_ur)
     arm = RosArm(ArmConfig(v=args.v, a=args.a), master_uri=args.master, log=remote.say_for(args))
     outcome: dict[str, object] = {"start": job.start + 1, "end": job.end + 1, "blocks": job.n_blocks, "v": args.v,
                                   "a": args.a}

@@ -50,6 +50,7 @@ from ur3hanoi.cli.prompt import towers
 from ur3hanoi.errors import SuctionFaultError, Ur3HanoiError
 
 if TYPE_CHECKING:
+    from ur3hanoi.opengl import Choice
     from ur3hanoi.plan import Plan
     from ur3hanoi.sim import ProgressFn, SimResult, TaskScene
     from ur3hanoi.station.calibration import Station
@@ -91,8 +92,8 @@ def add(sub: argparse._SubParsersAction) -> None:
     out = p.add_mutually_exclusive_group()
     out.add_argument("--video", metavar="FILE",
                      help=f"render a video offscreen, by extension {', '.join(VIDEO_EXTENSIONS)} (needs "
-                          "imageio-ffmpeg; headless: MUJOCO_GL=egl)")
-    out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR (headless: MUJOCO_GL=egl)")
+                          "imageio-ffmpeg; OpenGL: the display's, else EGL, else OSMesa, or MUJOCO_GL)")
+    out.add_argument("--frames", metavar="DIR", help="render PNG frames offscreen into DIR (OpenGL as --video)")
     p.add_argument("--fps", type=option(FPS), default=None, metavar="HZ",
                    help=f"frames per second of sim time, {FPS.expected()} (default 30)")
     p.add_argument("--size", type=image_size, default=None, metavar="WxH",
@@ -133,8 +134,9 @@ def _check_render_options(args: argparse.Namespace) -> None:
     check_window(args.t_from, args.t_to)
 
 
-def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
-    """Refuse a video or frames path that cannot be written, before simulating anything."""
+def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> Choice | None:
+    """Refuse a video or frames path that cannot be written, before simulating anything; choose the OpenGL
+    platform when the run renders (the choice; None: it does not)."""
     from ur3hanoi.io.atomic import check_output
 
     if args.html:
@@ -146,7 +148,7 @@ def _check_render_outputs(args: argparse.Namespace, inputs: list[Path]) -> None:
         except ImportError:
             raise UsageError("--video needs the video extra (imageio-ffmpeg, which ships ffmpeg): pip install "
                              "'ur3hanoi[video]'; or write PNG frames with --frames DIR") from None
-    check_render_outputs(args.video, args.frames, inputs)
+    return check_render_outputs(args.video, args.frames, inputs)
 
 
 def _table_calibration(args: argparse.Namespace) -> str:
@@ -172,6 +174,7 @@ class _Job(NamedTuple):
     n_blocks: int
     table: Any  # the visited entries of a recorded table (FloatArray), or None: generated waypoints
     inputs: list[Path]
+    gl: Choice | None  # the OpenGL platform the run renders with (None: it does not render)
 
 
 def _job(args: argparse.Namespace) -> _Job:
@@ -207,28 +210,26 @@ def _job(args: argparse.Namespace) -> _Job:
     check_faults(args.remove_block, args.drop_during_move, n_blocks)
     plan_config = PlanConfig(speed=args.speed)
     check_plan_size(n_blocks, args.speed, plan_config.dwell_s, plan_config.rate_hz)
-    if (args.video or args.frames) and "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
-        # Headless offscreen rendering: read when MuJoCo is first imported (the output check below imports it).
-        os.environ["MUJOCO_GL"] = "egl"
-    _check_render_outputs(args, inputs)
-    return _Job(station, start, end, n_blocks, table, inputs)
+    gl = _check_render_outputs(args, inputs)  # MuJoCo is imported after this, with the platform chosen
+    return _Job(station, start, end, n_blocks, table, inputs, gl)
 
 
-def _sink(args: argparse.Namespace, station: Station, scene: TaskScene) -> tuple[object | None, ProgressFn | None]:
+def _sink(args: argparse.Namespace, job: _Job, scene: TaskScene) -> tuple[object | None, ProgressFn | None]:
     """(frame sink: the viewer, the offscreen recorder or none; the simulation's progress)."""
     from ur3hanoi.sim import CameraConfig, OffscreenRecorder, ViewerSink
 
     if args.view:
         return ViewerSink(scene.model, scene.data), None
-    if not (args.video or args.frames):
+    if job.gl is None:
         return None, progress_sink(args, None)
+    print(f"ur3hanoi solve: rendering with {job.gl.describe()}", file=sys.stderr, flush=True)
     workers = render_workers()
     sim_progress, render_progress = (phases(progress_sink(args, None)) if workers > 1  # frames render afterwards
                                      else (None, None))
     default = CameraConfig()
     width, height = args.size if args.size is not None else (default.width, default.height)
     camera = CameraConfig(width=width, height=height, fps=args.fps if args.fps is not None else default.fps)
-    sink = OffscreenRecorder(station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
+    sink = OffscreenRecorder(job.station, scene.model, frames_dir=Path(args.frames) if args.frames else None,
                              video=Path(args.video) if args.video else None, camera=camera,
                              t_from=args.t_from or 0.0, t_to=args.t_to, workers=workers, progress=render_progress)
     return sink, sim_progress if sim_progress is not None else progress_sink(args, sink)
@@ -240,7 +241,7 @@ def _simulate(args: argparse.Namespace, job: _Job, plan: Plan, scene: TaskScene,
     None, the frame sink, the replay recorder). An interrupted or failed run leaves an existing video as it was."""
     from ur3hanoi.sim import OffscreenRecorder, SimResult, run_plan
 
-    sink, sim_progress = _sink(args, job.station, scene)
+    sink, sim_progress = _sink(args, job, scene)
     frames, replay = sink, None
     fault: Ur3HanoiError | None = None
     try:
@@ -270,10 +271,10 @@ def _simulate(args: argparse.Namespace, job: _Job, plan: Plan, scene: TaskScene,
 
 
 def run(args: argparse.Namespace) -> int:
+    job = _job(args)  # first: it chooses the OpenGL platform, which MuJoCo reads when it is imported
     from ur3hanoi.plan import PlanConfig, plan_solve, plan_table
     from ur3hanoi.sim import Faults, SimConfig, build_task_scene, display_available
 
-    job = _job(args)
     station, start, end, n_blocks = job.station, job.start, job.end, job.n_blocks
     if args.view and display_available() is not None:
         raise UsageError(f"--view cannot open the MuJoCo viewer: {display_available()}; "

@@ -21,6 +21,10 @@ Server side:
 - :mod:`~ur3hanoi.interface.lograte`: log lines a flood cannot multiply (one per topic and second, with counts).
 - :mod:`~ur3hanoi.interface.errors`: :class:`~ur3hanoi.interface.errors.CommandError`.
 
+The official UR driver's interface (``--driver ur``), middleware-neutral as well: :mod:`ur3hanoi.interface.urdriver`
+(the scaled trajectory controller, IO, the station on :class:`~ur3hanoi.interface.server.ServerCore`, the plan as
+goals and the client's solve); the bindings' ``ur_*`` modules serve and drive it.
+
 Client side:
 
 - :mod:`~ur3hanoi.interface.client`: the move-and-wait and suction feedback over three topics,

@@ -27,12 +27,14 @@ class LoopTiming:
         self.period_s = period_s
         self.cycles = 0
         self.worst_lag_s = 0.0
+        self.last_lag_s = 0.0
         self.total_lag_s = 0.0
         self.late_cycles = 0  # started more than one period late
         self.histogram = [0] * (len(LAG_BINS_MS) + 1)
 
     def add(self, lag_s: float) -> None:
         self.cycles += 1
+        self.last_lag_s = lag_s
         self.total_lag_s += max(0.0, lag_s)
         self.worst_lag_s = max(self.worst_lag_s, lag_s)
         if lag_s > self.period_s:

@@ -42,9 +42,11 @@ def _worker(parent: int, conn: Connection, calibration: str, n_blocks: int, fram
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the station stops us (a Ctrl-C must not cut the video short)
     child_start(parent)  # SIGTERM at its default until the recorder exists: nothing to discard before
     os.environ.setdefault("LP_NUM_THREADS", "1")  # llvmpipe: leave the other core to the control loop
-    os.environ.setdefault("MUJOCO_GL", "egl")
     os.nice(10)
     try:
+        from ur3hanoi.opengl import use_platform
+
+        use_platform()  # the station's command chose it (MUJOCO_GL, inherited): nothing to try again
         import mujoco
 
         from ur3hanoi.sim import OffscreenRecorder, build_task_scene
@@ -103,7 +105,7 @@ class FrameProcess:
         hello = self._conn.recv()
         if not str(hello).startswith("ready"):
             self._kill()
-            raise SimulationError(f"offscreen rendering failed: {str(hello).removeprefix('error: ')}")
+            raise SimulationError(f"the rendering process could not start: {str(hello).removeprefix('error: ')}")
         self.fps = float(str(hello).split()[1])
 
     def _collect(self) -> None:

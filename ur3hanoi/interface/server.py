@@ -37,7 +37,7 @@ from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
 
 from ur3hanoi.errors import InputError
 from ur3hanoi.interface.errors import CommandError
@@ -45,6 +45,14 @@ from ur3hanoi.interface.inbox import INBOX_MAX, Inbox
 from ur3hanoi.interface.realtime import RealTimeLoop
 from ur3hanoi.interface.render import FrameOutput
 
+if TYPE_CHECKING:
+    from ur3hanoi.sim.config import SimConfig
+    from ur3hanoi.sim.task_world import TaskWorld
+
+WorldT = TypeVar("WorldT", bound="TaskWorld")
+
+BEHIND_WARNING_S = 0.25
+"""A control loop more than this [s] behind its schedule says so on its log, once a second."""
 _SUCTION_KINDS = frozenset({"suction_on", "suction_off", "grasp", "release"})
 
 
@@ -59,7 +67,8 @@ class ServerOptions:
         removed: height left empty at spawn (fault injection), or None.
         drop_on_grasp: the block of this grasp falls off during the next motion (fault injection), or None.
         seed: seed of the analog suction feedback's noise.
-        rate_hz: control and publishing rate [Hz]; its period must be a multiple of the 2 ms physics step.
+        rate_hz: control and publishing rate [Hz]; its period must be a multiple of the 2 ms physics step. None:
+            the calibration's robot's control rate (CB3 125 Hz, e-Series 500 Hz).
         report: JSON report file, or None for ``report_out``.
         duration_s: stop by itself after this wall time [s], or None (until SIGINT/SIGTERM).
         suction_profile: a named suction feedback profile (``lab_sim``, ``real``) replacing the calibration's,
@@ -74,7 +83,7 @@ class ServerOptions:
     removed: int | None = None
     drop_on_grasp: int | None = None
     seed: int = 0
-    rate_hz: float = 125.0
+    rate_hz: float | None = 125.0
     report: Path | None = None
     duration_s: float | None = None
     suction_profile: str | None = None
@@ -82,19 +91,35 @@ class ServerOptions:
     video: Path | None = None
 
 
-def _checked(opts: ServerOptions, n_heights: int) -> int:
-    """The number of blocks ``opts`` asks for, after checking it, the rate and the grasp to drop."""
+def _checked(opts: ServerOptions, n_heights: int, robot_rate_hz: float) -> tuple[int, float]:
+    """The number of blocks and the rate [Hz] ``opts`` asks for, after checking them and the grasp to drop."""
     n_blocks = n_heights if opts.n_blocks is None else opts.n_blocks
     if not 1 <= n_blocks <= n_heights:
         raise InputError(f"{n_blocks} blocks is invalid: expected 1..{n_heights} (the grid's heights)")
-    if not (math.isfinite(opts.rate_hz) and 50.0 <= opts.rate_hz <= 500.0):
-        raise InputError(f"rate {opts.rate_hz} Hz is invalid: expected 50..500 Hz (the period a multiple of 2 ms)")
+    rate = robot_rate_hz if opts.rate_hz is None else opts.rate_hz
+    if not (math.isfinite(rate) and 50.0 <= rate <= 500.0):
+        raise InputError(f"rate {rate} Hz is invalid: expected 50..500 Hz (the period a multiple of 2 ms)")
     if opts.drop_on_grasp is not None and opts.drop_on_grasp < 0:
         raise InputError(f"grasp {opts.drop_on_grasp + 1} is invalid: expected a grasp number >= 1")
-    return n_blocks
+    return n_blocks, rate
 
 
-class ServerCore:
+def _spawn_or_remove(core: ServerCore[Any], kind: str, payload: Any) -> None:
+    """Respawn the blocks on tower ``payload`` (``spawn``) or take block ``payload`` away (``remove``), numbered
+    from 1; a bad number is logged."""
+    topic, w = core.TOPIC_LOG[kind], core.world
+    n = core.station.n_towers if kind == "spawn" else w.n_blocks
+    if not (isinstance(payload, int) and 1 <= payload <= n):
+        core.log.log(topic, "error", f"{'tower' if kind == 'spawn' else 'block'} {payload!r} is invalid: expected "
+                                     f"1..{n}")
+    elif kind == "spawn":
+        w.spawn(payload - 1)
+        core.log.log(topic, "info", f"{w.n_blocks} blocks respawned on tower {payload}")
+    else:
+        core.log.log(topic, "warn", f"block {payload} {w.remove(payload - 1)}")
+
+
+class ServerCore(Generic[WorldT]):
     """The simulated station as a real-time node without a transport (see the module docstring).
 
     A binding sets :attr:`TOPIC_LOG` (the log-line prefix of each kind of message), may override
@@ -115,10 +140,8 @@ class ServerCore:
 
     def __init__(self, options: ServerOptions, out: Callable[[str], None],
                  report_out: Callable[[str], None]) -> None:
-        from ur3hanoi.interface.controller import Controller
         from ur3hanoi.interface.lograte import RateLimitedLog
         from ur3hanoi.sim.config import SimConfig
-        from ur3hanoi.sim.world import MoveJWorld
         from ur3hanoi.station.calibration import load_station, with_suction_profile
 
         self.options = opts = options
@@ -127,15 +150,24 @@ class ServerCore:
         self.station = load_station(opts.calibration)
         if opts.suction_profile is not None:
             self.station = with_suction_profile(self.station, opts.suction_profile)
-        n_blocks = _checked(opts, self.station.n_heights)
-        config = SimConfig(period_s=1.0 / opts.rate_hz, seed=opts.seed)
-        self.world = MoveJWorld(self.station, opts.start, n_blocks, opts.removed, config, opts.drop_on_grasp)
-        self.controller = Controller(self.world)
+        n_blocks, rate = _checked(opts, self.station.n_heights, self.station.robot.control_rate_hz)
+        config = SimConfig(period_s=1.0 / rate, seed=opts.seed)
+        self.world: WorldT = self._build_world(config, n_blocks)
         self.clock = RealTimeLoop(config.period_s)
         self.reports_written = 0
         self.inbox = Inbox()
         self.log = RateLimitedLog(self._emit)
         self.frames = FrameOutput(opts.calibration, n_blocks, opts.frames, opts.video)
+
+    def _build_world(self, config: SimConfig, n_blocks: int) -> WorldT:
+        """The simulated station and what drives it: the course's ``movej`` controller (a subclass: another)."""
+        from ur3hanoi.interface.controller import Controller
+        from ur3hanoi.sim.world import MoveJWorld
+
+        opts = self.options
+        world = MoveJWorld(self.station, opts.start, n_blocks, opts.removed, config, opts.drop_on_grasp)
+        self.controller = Controller(world)
+        return world  # type: ignore[return-value]  # the course's world; a subclass builds its own
 
     # ---------------------------------------------------------------------------------------------- callbacks
     def on_command(self, msg: Any) -> None:
@@ -175,28 +207,23 @@ class ServerCore:
         for kind, n in overflow.items():
             reason = f"the station's inbox is full ({INBOX_MAX} messages not yet handled): message dropped"
             for _ in range(n):
-                if kind == "command":
-                    self.controller.refuse(reason)
+                self._dropped(kind, reason)
                 self.log.log(self.TOPIC_LOG[kind], "error", reason)
         for kind, payload in received:
-            if kind == "command":
-                self.submit_command(payload)
-            elif kind == "spawn":
-                n = self.station.n_towers
-                if isinstance(payload, int) and 1 <= payload <= n:
-                    self.world.spawn(payload - 1)
-                    self.log.log(self.TOPIC_LOG[kind], "info",
-                                 f"{self.world.n_blocks} blocks respawned on tower {payload}")
-                else:
-                    self.log.log(self.TOPIC_LOG[kind], "error", f"tower {payload!r} is invalid: expected 1..{n}")
-            else:
-                n = self.world.n_blocks
-                if isinstance(payload, int) and 1 <= payload <= n:
-                    what = self.world.remove(payload - 1)
-                    self.log.log(self.TOPIC_LOG[kind], "warn", f"block {payload} {what}")
-                else:
-                    self.log.log(self.TOPIC_LOG[kind], "error", f"block {payload!r} is invalid: expected 1..{n}")
+            self._handle(kind, payload)
         self.log.flush()
+
+    def _dropped(self, kind: str, reason: str) -> None:
+        """A message of ``kind`` the full inbox refused (recorded by a subclass's controller)."""
+        if kind == "command":
+            self.controller.refuse(reason)
+
+    def _handle(self, kind: str, payload: Any) -> None:
+        """One message from the inbox: a command, a spawn or a removal (a subclass adds its own kinds)."""
+        if kind == "command":
+            self.submit_command(payload)
+        else:
+            _spawn_or_remove(self, kind, payload)
 
     # --------------------------------------------------------------------------------------------- rendering
     @contextmanager
@@ -216,6 +243,10 @@ class ServerCore:
     def cycle(self) -> None:
         """One control period without a transport: handle the inbox, then one driver and world step."""
         self._drain()
+        self._step()
+
+    def _step(self) -> None:
+        """One driver and world step (the course's controller; a subclass: its own)."""
         self.controller.cycle()
 
     # ------------------------------------------------------------------------------------------------ report
@@ -223,40 +254,19 @@ class ServerCore:
         """The binding's sections after ``suction`` (e.g. the master, the DDS domain)."""
         return {}
 
+    def _report_motion(self) -> dict[str, Any]:
+        """The report's sections on what was commanded: the course controller's commands (a subclass: its own)."""
+        return {"commands": self.controller.summary(),
+                "executed": [m.as_dict() for m in self.controller.executed],
+                "rejected": [r.as_dict() for r in self.controller.rejected]}
+
+    def _report_final(self) -> dict[str, Any]:
+        """The controller's part of the report's ``final`` section."""
+        return {"ready": self.controller.ready}
+
     def report(self) -> dict[str, Any]:
         """The JSON report (see the module docstring); numbering from 1."""
-        w, st = self.world, self.station
-        events = [e.as_dict() for e in w.events]  # the last EVENTS_KEPT; counts of all in "event_counts"
-        wall = self.clock.wall_s
-        holding = w.holding
-        return {
-            "station": {"name": st.name, "calibration": st.source, "sha256": st.sha256, "robot": st.robot.name},
-            "suction": w.cup.profile.as_dict(),
-            **self._report_transport(),
-            "blocks": w.n_blocks,
-            "start_tower": self.options.start + 1,
-            "wall_time_s": round(wall, 3),
-            "world_time_s": round(w.time, 3),
-            "control": self.clock.timing.as_dict(wall),
-            "commands": self.controller.summary(),
-            "executed": [m.as_dict() for m in self.controller.executed],
-            "rejected": [r.as_dict() for r in self.controller.rejected],
-            "suction_events": [e for e in events if e["kind"] in _SUCTION_KINDS],
-            "faults": [e for e in events if e["kind"] in ("removed", "dropped")],
-            "spawns": [e for e in events if e["kind"] == "spawn"],
-            "event_counts": dict(w.event_counts),
-            "log_lines": self.log.lines,
-            "final": {
-                "q": [round(float(x), 9) for x in w.q],
-                "ready": self.controller.ready,
-                "suction_on": w.suction_on,
-                "holding": None if holding is None else holding + 1,
-                "at_home": w.at_home(),
-                "blocks": [b.as_dict() for b in w.blocks()],
-            },
-            "frames": self.frames.counts(),
-            "reports_written": self.reports_written + 1,
-        }
+        return _report(self)
 
     def write_report(self) -> dict[str, Any]:
         """Write :meth:`report` to ``options.report`` (atomically) or to ``report_out``; returns it."""
@@ -286,6 +296,44 @@ class ServerCore:
             self.cycle()
             publish()
             self.frames.offer(self.world.time, self.world.scene.data.qpos)
+            lag = self.clock.timing.last_lag_s
+            if lag > BEHIND_WARNING_S:  # at most one line a second (RateLimitedLog)
+                self.log.log("loop", "warn", f"the station is {1e3 * lag:.0f} ms behind real time: the machine "
+                             "is too busy for this control rate (close other programs, or lower --rate)")
 
         self.out(ready_line)
         self.clock.run(step, running, self.write_report, self.options.duration_s)
+
+
+def _report(core: ServerCore[Any]) -> dict[str, Any]:
+    """:meth:`ServerCore.report`."""
+    w, st = core.world, core.station
+    events = [e.as_dict() for e in w.events]  # the last EVENTS_KEPT; counts of all in "event_counts"
+    wall = core.clock.wall_s
+    holding = w.holding
+    return {
+        "station": {"name": st.name, "calibration": st.source, "sha256": st.sha256, "robot": st.robot.name},
+        "suction": w.cup.profile.as_dict(),
+        **core._report_transport(),
+        "blocks": w.n_blocks,
+        "start_tower": core.options.start + 1,
+        "wall_time_s": round(wall, 3),
+        "world_time_s": round(w.time, 3),
+        "control": core.clock.timing.as_dict(wall),
+        **core._report_motion(),
+        "suction_events": [e for e in events if e["kind"] in _SUCTION_KINDS],
+        "faults": [e for e in events if e["kind"] in ("removed", "dropped")],
+        "spawns": [e for e in events if e["kind"] == "spawn"],
+        "event_counts": dict(w.event_counts),
+        "log_lines": core.log.lines,
+        "final": {
+            "q": [round(float(x), 9) for x in w.q],
+            **core._report_final(),
+            "suction_on": w.suction_on,
+            "holding": None if holding is None else holding + 1,
+            "at_home": w.at_home(),
+            "blocks": [b.as_dict() for b in w.blocks()],
+        },
+        "frames": core.frames.counts(),
+        "reports_written": core.reports_written + 1,
+    }

@@ -29,8 +29,8 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TypeVar
 
-from ur3hanoi import __version__
 from ur3hanoi.errors import Ur3HanoiError
+from ur3hanoi.version import __version__
 
 FORMAT = 1
 """Version of the entry layout (header fields, base64 payload)."""

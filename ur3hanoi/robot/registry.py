@@ -65,6 +65,13 @@ class RobotDescription:
             the UR URDF layout (``d4 = shoulder_offset - elbow_offset + wrist-2 offset``); they place the link
             shapes, not the kinematics.
         link_radius: radius [m] of the link shapes of a generated model: base/shoulder, upper arm/forearm, wrists.
+        control_rate_hz: the controller's servo rate [Hz]: 125 on CB3, 500 on e-Series (the official drivers'
+            ``loop_hz`` / ``update_rate``; URCL ``rtde_client.h``).
+        course_suction_io: the course's suction wiring on this arm: (digital output switching the vacuum, digital
+            input of the vacuum switch, analog input of the vacuum sensor), as ``set_io`` / ``io_states`` pins.
+            UR3: the lab manual's feedback on Digital Input 0 and Analog Input 0; its output is named nowhere in
+            the course material: digital output 0 is **unverified** (the course message's field is ``io_0``).
+            UR3e: UMD ENME480's bridge switches digital output 1 and reads digital input 0, analog input 0.
     """
 
     name: str
@@ -82,12 +89,17 @@ class RobotDescription:
     shoulder_offset: float = 0.1198
     elbow_offset: float = 0.0925
     link_radius: tuple[float, float, float] = (0.045, 0.035, 0.03)
+    control_rate_hz: float = 125.0
+    course_suction_io: tuple[int, int, int] = (0, 0, 0)
 
 
 _SPEED = (math.pi,) * 3 + (2 * math.pi,) * 3  # 180 deg/s joints 1-3, 360 deg/s wrists (both datasheets)
 _ACC = (4.0,) * 3 + (8.0,) * 3
-CB3_CONTROL_PERIOD_S = 0.008
-"""[s] The CB3 controller's servo cycle (125 Hz)."""
+CB3_CONTROL_RATE_HZ = 125.0
+E_SERIES_CONTROL_RATE_HZ = 500.0
+"""[Hz] The controllers' servo rates (see :attr:`RobotDescription.control_rate_hz`)."""
+CB3_CONTROL_PERIOD_S = 1.0 / CB3_CONTROL_RATE_HZ
+"""[s] The CB3 controller's servo cycle (8 ms)."""
 # [rad/s^3] Each acceleration cap reached within one CB3 servo cycle: 500 / 1000 rad/s^3. UR publishes no jerk
 # limit; the source and what it costs the carried block are written at ur3hanoi.robot.model.DEFAULT_JERK_MAX. The UR3e
 # keeps the same value: the simulated suction hold that grounds it was measured up to 2000 rad/s^3 on the UR3.
@@ -99,6 +111,7 @@ UR3 = RobotDescription(
                     alpha=_UR_ALPHA),
     v_max=_SPEED, a_max=_ACC, j_max=_JERK, torque=(56.0, 56.0, 28.0, 12.0, 12.0, 12.0),
     model_source="urdf", urdf_file="ur3_robot.urdf", mjcf_dir="universal_robots_ur3",
+    control_rate_hz=CB3_CONTROL_RATE_HZ, course_suction_io=(0, 0, 0),
 )
 
 UR3E = RobotDescription(
@@ -111,6 +124,7 @@ UR3E = RobotDescription(
     com_dh=((0.0, -0.02, 0.0), (0.13, 0.0, 0.1157), (0.05, 0.0, 0.0238), (0.0, 0.0, 0.01), (0.0, 0.0, 0.01),
             (0.0, 0.0, -0.02)),
     shoulder_offset=0.12, elbow_offset=0.093, link_radius=(0.046, 0.035, 0.0315),
+    control_rate_hz=E_SERIES_CONTROL_RATE_HZ, course_suction_io=(1, 0, 0),
 )
 
 ROBOTS: dict[str, RobotDescription] = {r.name: r for r in (UR3, UR3E)}

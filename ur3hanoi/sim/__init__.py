@@ -23,11 +23,14 @@ Modules, in order of dependency (each imports only the ones above it):
 - :mod:`~ur3hanoi.sim.executor`: ``solve``'s driver: :func:`run_plan` streams a :class:`ur3hanoi.plan.Plan`, checks
   the suction like the lab program, halts on a fault (raising :class:`ur3hanoi.errors.SuctionFaultError` with the
   result) and verifies the final block positions (:class:`Faults`).
-- :mod:`~ur3hanoi.sim.world`: the ROS servers' driver: :class:`MoveJWorld` runs ``movej`` commands one control
-  period at a time (servo, suction, blocks, :class:`WorldEvent`).
+- :mod:`~ur3hanoi.sim.task_world`: what the ROS servers drive one control period at a time: the scene, servo, suction
+  and blocks of a station (:class:`~ur3hanoi.sim.task_world.TaskWorld`, :class:`WorldEvent`).
+- :mod:`~ur3hanoi.sim.world`: the course interface's world: :class:`MoveJWorld` runs ``movej`` commands.
+- :mod:`~ur3hanoi.sim.servo_world`: the official UR driver's world: :class:`ServoWorld`, the robot under a streaming
+  trajectory controller (joint limits, its own speed scaling times the slider, an arm that can be held).
 - :mod:`~ur3hanoi.sim.render`: offscreen frames/video and the interactive viewer (:class:`CameraConfig`,
-  :class:`OffscreenRecorder`, :data:`VIDEO_FORMATS`, :func:`check_video_path`, :class:`ViewerSink`,
-  :func:`display_available`).
+  :class:`OffscreenRecorder`, :data:`VIDEO_FORMATS`, :func:`check_video_path`, :class:`ViewerSink`), with the
+  OpenGL platform chosen before MuJoCo is imported (:mod:`ur3hanoi.opengl`; :func:`display_available` is its).
 
 Frames: MuJoCo's world is the station's world. The URDF root ``base_link`` is placed at
 ``T_world_base * Rz(pi)`` so that MuJoCo's ``suction`` site equals ``T_world_base * Ur3Model.fk(q, "tcp")``.
@@ -36,6 +39,7 @@ Joint values are the controller/DH convention (they equal the URDF's, see :mod:`
 Numbering: internally 0-based (towers, heights, blocks, moves); messages and JSON are 1-based like the lab.
 """
 
+from ur3hanoi.opengl import display_available
 from ur3hanoi.sim.config import SimConfig
 from ur3hanoi.sim.executor import Faults, FrameSink, ProgressFn, run_plan
 from ur3hanoi.sim.halt import DEFAULT_HALT_PROFILE, HaltProfile
@@ -56,7 +60,6 @@ from ur3hanoi.sim.render import (
     VideoFormat,
     ViewerSink,
     check_video_path,
-    display_available,
 )
 from ur3hanoi.sim.result import DisplacedBlock, FeedbackEvent, FinalBlock, JointTrace, SimResult
 from ur3hanoi.sim.scene import (
@@ -70,7 +73,9 @@ from ur3hanoi.sim.scene import (
     start_slots,
     warning_counts,
 )
+from ur3hanoi.sim.servo_world import ServoWorld
 from ur3hanoi.sim.suction import GripperInput, SuctionConfig, SuctionCup
+from ur3hanoi.sim.task_world import TaskWorld
 from ur3hanoi.sim.world import MoveJWorld, WorldEvent
 
 __all__ = [
@@ -94,11 +99,13 @@ __all__ = [
     "OffscreenRecorder",
     "ProgressFn",
     "SceneConfig",
+    "ServoWorld",
     "SimConfig",
     "SimResult",
     "SuctionConfig",
     "SuctionCup",
     "TaskScene",
+    "TaskWorld",
     "VideoFormat",
     "ViewerSink",
     "WorldEvent",

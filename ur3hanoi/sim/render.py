@@ -11,7 +11,8 @@ absolute path, so a name like ``-x.mp4`` is never an ffmpeg option) that replace
 is closed normally; frames go to a temporary folder moved into place on close. An error, or leaving the ``with``
 block by an exception, discards them: an existing video or folder stays as it was.
 
-Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo is imported.
+MuJoCo renders with the OpenGL platform it was imported with (``MUJOCO_GL``): call
+:func:`ur3hanoi.opengl.use_platform` first (the commands do), or set ``MUJOCO_GL``.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ import numpy as np
 
 from ur3hanoi.errors import OutputError, SimulationError, Ur3HanoiError, printable, quote
 from ur3hanoi.io.atomic import PendingDir, PendingFile, check_output, check_output_dir
+from ur3hanoi.opengl import display_available, offscreen_renderer
 from ur3hanoi.sim.scene import slot_centers
 from ur3hanoi.station.calibration import Station
 
@@ -162,7 +164,7 @@ def _init_worker(parent: int, model: mujoco.MjModel, lookat: tuple[float, float,
     # One llvmpipe thread per process: the processes are the parallelism (read when the GL driver loads).
     os.environ.setdefault("LP_NUM_THREADS", "1")
     _WORKER["model"], _WORKER["data"] = model, mujoco.MjData(model)
-    _WORKER["renderer"] = mujoco.Renderer(model, cam.height, cam.width)
+    _WORKER["renderer"] = offscreen_renderer(model, cam.height, cam.width)
     _WORKER["camera"], _WORKER["cam"] = _camera(lookat, cam), cam
 
 
@@ -181,11 +183,10 @@ class OffscreenRecorder:
     is the number written. With ``workers`` > 1 the run only records each frame's joint state, and
     :meth:`render_pending` (called by the context manager on success) renders them in that many processes
     (``spawn``, one software-GL thread each), in order, reporting ``progress(fraction, label)`` per frame, while
-    ffmpeg encodes in its own process. Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) set before MuJoCo
-    is imported. A video needs ``imageio-ffmpeg`` (its wheel ships ffmpeg) and an extension of
-    :data:`VIDEO_FORMATS`; PNG needs only Pillow. Use as a context manager (it closes the renderer and finishes the
-    file, or :meth:`discard` s it when the block raises). The output is checked here (:mod:`ur3hanoi.io.atomic`)
-    and written only on close.
+    ffmpeg encodes in its own process. OpenGL: see the module docstring. A video needs ``imageio-ffmpeg`` (its
+    wheel ships ffmpeg) and an extension of :data:`VIDEO_FORMATS`; PNG needs only Pillow. Use as a context manager
+    (it closes the renderer and finishes the file, or :meth:`discard` s it when the block raises). The output is
+    checked here (:mod:`ur3hanoi.io.atomic`) and written only on close.
     """
 
     def __init__(self, station: Station, model: mujoco.MjModel, frames_dir: Path | None = None,
@@ -234,13 +235,7 @@ class OffscreenRecorder:
         self.model, self.lookat = model, _lookat(station)
         self.workers, self.progress = max(1, int(workers)), progress
         self._states: list[tuple[float, Any]] = []  # (t, qpos) of the frames to render in parallel at close()
-        try:
-            self.renderer = mujoco.Renderer(model, cam.height, cam.width)
-        except ValueError:  # a size the framebuffer does not hold: a bug here, not a missing OpenGL
-            raise
-        except Exception as exc:  # no OpenGL context: the message says which backend failed
-            raise SimulationError(f"offscreen rendering is unavailable ({exc}); on a headless machine set "
-                                  "MUJOCO_GL=egl (libegl1) or MUJOCO_GL=osmesa (libosmesa6)") from None
+        self.renderer = offscreen_renderer(model, cam.height, cam.width)
         self.camera = _free_camera(station, cam)
         self._pool: Any = None
         if self.workers > 1:
@@ -367,13 +362,6 @@ class OffscreenRecorder:
             raise
         finally:
             self.close()
-
-
-def display_available() -> str | None:
-    """None when an interactive viewer can open, else the reason it cannot."""
-    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        return "no display (DISPLAY and WAYLAND_DISPLAY are unset)"
-    return None
 
 
 class ViewerSink:

@@ -59,11 +59,13 @@ from ur3hanoi.station.suction_profile import (
     parse_suction,
     suction_section,
 )
+from ur3hanoi.station.suction_wiring import IO_SECTION, SuctionWiring, course_wiring, parse_wiring
 
 if TYPE_CHECKING:
     import pinocchio as pin
 
 Vec3 = tuple[float, float, float]
+DEFAULT_WIRING = course_wiring(DEFAULT_ROBOT)
 Layout = Literal["flat", "stacked"]
 LAYOUTS: tuple[str, ...] = ("flat", "stacked")
 
@@ -91,6 +93,8 @@ class Station:
         suction: what the suction feedback reads (``suction:`` section; the course simulator's levels by
             default), see :mod:`ur3hanoi.station.suction_profile`.
         robot: the arm (``robot.model``; the UR3 by default), see :mod:`ur3hanoi.robot.registry`.
+        wiring: the suction's pins for the official UR drivers (``io:`` section; the course's wiring on the arm by
+            default), see :mod:`ur3hanoi.station.suction_wiring`.
     """
 
     name: str
@@ -111,6 +115,7 @@ class Station:
     sha256: str = ""
     suction: SuctionProfile = DEFAULT_PROFILE
     robot: RobotDescription = DEFAULT_ROBOT
+    wiring: SuctionWiring = DEFAULT_WIRING
 
     @property
     def n_towers(self) -> int:
@@ -207,6 +212,7 @@ STATION_SCHEMA = Record({
         "approach": Field(Number(0.0, 0.5, lo_open=True, unit=_M, what="a length")),
     })),
     "suction": Field(SUCTION_SECTION, required=False),
+    "io": Field(IO_SECTION, required=False),
 })
 """The calibration file's schema: every key, its type and range (see ``ur3hanoi/station/shipped/README.md``)."""
 
@@ -299,6 +305,7 @@ def parse_station(data: Any, source: str = "<memory>") -> Station:
         limits=limits, tool=tool_offset, tool_yaw=tool_yaw, block_size=block_size, contact_depth=depth,
         tower_origins=origins, height_step=_vec3(grid["height_step"]), n_heights=n_heights,
         approach=float(grid["approach"]), source=source, suction=suction, robot=arm,
+        wiring=parse_wiring(data.get("io"), arm),
     )
     validate(station)
     return station
@@ -378,4 +385,5 @@ def station_to_dict(s: Station) -> dict[str, Any]:
             "approach": round(s.approach, 12),
         },
         "suction": suction_section(s.suction),
+        **({} if s.wiring == course_wiring(s.robot) else {"io": s.wiring.as_dict()}),
     }

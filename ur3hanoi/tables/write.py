@@ -12,7 +12,6 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ur3hanoi import __version__
 from ur3hanoi.errors import printable
 from ur3hanoi.io.resources import station_file
 from ur3hanoi.station.grid import block_xy_pos
@@ -21,6 +20,7 @@ from ur3hanoi.tables.format import format_q, format_xy
 from ur3hanoi.tables.ik_table import Table
 from ur3hanoi.tables.sections import Sections
 from ur3hanoi.tables.update import write_sections
+from ur3hanoi.version import __version__
 
 
 def _provenance(key: str, table: Table, label: str, with_solver: bool, convention: str = "controller") -> str:

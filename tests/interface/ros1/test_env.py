@@ -109,3 +109,14 @@ def test_ros_env_applied_twice_is_harmless(tmp_path, python):
     lines = out.stdout.splitlines()
     assert lines[0].split(":") == [str(tmp_path / "b"), str(tmp_path / "a"), str(tmp_path / "a"), str(other)]
     assert lines[1].split() == [MD5[0], "1"]
+
+
+def test_missing_driver_packages_are_named(tmp_path):
+    code = ("import ur3hanoi.interface.ros1.env as e; e._DRIVER_MODULES = ('actionlib', 'no_such_module_msgs'); "
+            "e.ensure_driver_python()")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                            env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"})
+    assert result.returncode != 0
+    last = result.stderr.strip().splitlines()[-1]
+    assert "no_such_module_msgs (for the UR driver's interface) are not importable" in last
+    assert "python3-actionlib python3-actionlib-msgs python3-trajectory-msgs python3-sensor-msgs" in last

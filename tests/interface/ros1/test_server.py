@@ -138,7 +138,8 @@ def test_spawn_and_remove_topics_own_roscore_and_reports(tmp_path):
 
 def test_frames_render_in_a_separate_process_and_duration_stops_the_station(tmp_path):
     env = ros_env(free_port(), tmp_path)
-    env.setdefault("MUJOCO_GL", "egl")
+    for name in ("MUJOCO_GL", "UR3HANOI_OPENGL", "DISPLAY", "WAYLAND_DISPLAY"):  # it chooses its OpenGL itself
+        env.pop(name, None)
     frames = tmp_path / "frames"
     report = tmp_path / "report.json"
     result = run(ur3hanoi_cmd("ros-station", "--duration", "3", "--frames", str(frames), "--report", str(report)),
@@ -149,6 +150,8 @@ def test_frames_render_in_a_separate_process_and_duration_stops_the_station(tmp_
     assert len(list(frames.glob("frame_*.png"))) == data["frames"]["rendered"]
     assert data["control"]["cycles"] >= 0.5 * 3.0 * 125  # the loop ran (timing itself: bench/bench_ros.py)
     assert "ros-station stopped: 0 commands executed, 0 refused" in result.stderr
+    assert result.stderr.startswith("ur3hanoi ros-station: rendering with "), result.stderr
+    assert "MUJOCO_GL unset, no display" in result.stderr.splitlines()[0]
     assert result.stdout == ""  # the report went to --report
 
 

@@ -1,5 +1,6 @@
 """ros2-station against a real rclpy (ROS 2 Jazzy and Kilted wheels from PyPI, Fast-RTPS 2.14 / Fast DDS 3.2, each in
-its own throwaway environment built by tests/support/rclpy_support.py), everything inside a private network namespace:
+the environment ``ur3hanoi ros2-env`` builds, tests/support/rclpy_support.py), everything inside a private network
+namespace:
 the graph shows the node, its topics, types, hashes and QoS; an ENME480-style rclpy program solves 1 -> 3 and
 halts on a removed block."""
 
@@ -16,30 +17,18 @@ import numpy as np
 import pytest
 
 from tests.support import SUPPORT
-from tests.support.rclpy_support import DISTROS, build_env, python_for
+from tests.support.rclpy_support import DISTROS, PeerEnv, build_env
 from tests.support.ros2_support import NETNS_PROBLEM, REPO, in_netns
 from ur3hanoi.interface.ros2.msgs import TYPE_HASHES
 from ur3hanoi.robot.convention import from_controller
 from ur3hanoi.station.calibration import load_station
 
-PYTHONS = {distro: python_for(version) for distro, (version, _) in DISTROS.items()}
-
 pytestmark = [pytest.mark.rclpy, pytest.mark.skipif(NETNS_PROBLEM is not None, reason=NETNS_PROBLEM or "")]
 
 
 @pytest.fixture(scope="module", params=sorted(DISTROS))
-def rclpy_env(request: pytest.FixtureRequest) -> dict[str, str]:
-    distro = request.param
-    python = PYTHONS[distro]
-    if python is None:
-        pytest.skip(f"no Python {DISTROS[distro][0]} interpreter for the ROS 2 {distro} rclpy wheels")
-    return {**build_env(distro, python), "DISTRO": distro}
-
-
-def _peer(env: dict[str, str], *args: str) -> str:
-    """The shell command running a script with the rclpy environment (and only that process)."""
-    assigns = [f"{k}={shlex.quote(v)}" for k, v in env.items() if k not in ("RCLPY_PYTHON", "DISTRO")]
-    return " ".join(["env", *assigns, shlex.quote(env["RCLPY_PYTHON"]), *map(shlex.quote, args)])
+def rclpy_env(request: pytest.FixtureRequest) -> PeerEnv:
+    return build_env(request.param)
 
 
 def _station(tmp_path: Path, station_args: str = "") -> str:
@@ -62,10 +51,10 @@ exit $CODE
 """
 
 
-def _probe(rclpy_env: dict[str, str], tmp_path: Path, launch: str) -> dict[str, Any]:
+def _probe(rclpy_env: PeerEnv, tmp_path: Path, launch: str) -> dict[str, Any]:
     """The graph an rclpy peer sees (tests/support/rclpy_graph_probe.py) while ``launch`` runs (see
     :func:`_station_script`)."""
-    result = in_netns(_station_script(tmp_path, launch, _peer(rclpy_env, str(SUPPORT / "rclpy_graph_probe.py"))),
+    result = in_netns(_station_script(tmp_path, launch, rclpy_env.peer_command(str(SUPPORT / "rclpy_graph_probe.py"))),
                       180.0, REPO)
     assert result.returncode == 0, result.stdout + result.stderr
     graph: dict[str, Any] = json.loads(result.stdout.strip().splitlines()[-1])
@@ -73,9 +62,9 @@ def _probe(rclpy_env: dict[str, str], tmp_path: Path, launch: str) -> dict[str, 
 
 
 @pytest.fixture(scope="module")
-def graph(rclpy_env: dict[str, str], tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+def graph(rclpy_env: PeerEnv, tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     """What the rclpy peer's graph says about ``ros2-station`` (one station run per distro)."""
-    tmp_path = tmp_path_factory.mktemp(f"graph-{rclpy_env['DISTRO']}")
+    tmp_path = tmp_path_factory.mktemp(f"graph-{rclpy_env.distro}")
     return _probe(rclpy_env, tmp_path, _station(tmp_path))
 
 
@@ -95,11 +84,11 @@ KILTED_GAP = ("Fast DDS 3.2 never sets participant_guid for Cyclone's endpoints 
               "name it without listing the node twice (see test_kilted_files_cyclone_endpoints_under_gid_zero)")
 
 
-def test_graph_names_the_nodes_endpoints(rclpy_env: dict[str, str], graph: dict[str, Any],
+def test_graph_names_the_nodes_endpoints(rclpy_env: PeerEnv, graph: dict[str, Any],
                                          request: pytest.FixtureRequest) -> None:
     """Jazzy names the station's four endpoints after ur3hanoi_station; Kilted shows them as
     _CREATED_BY_BARE_DDS_APP_ (:data:`KILTED_GAP`), a known gap kept visible as a strict xfail."""
-    if rclpy_env["DISTRO"] == "kilted":
+    if rclpy_env.distro == "kilted":
         request.applymarker(pytest.mark.xfail(strict=True, reason=KILTED_GAP))
     assert _endpoint_nodes(graph) == {"ur3hanoi_station"}
 
@@ -136,14 +125,14 @@ except KeyboardInterrupt:
 """
 
 
-def test_kilted_files_cyclone_endpoints_under_gid_zero(rclpy_env: dict[str, str], tmp_path: Path) -> None:
+def test_kilted_files_cyclone_endpoints_under_gid_zero(rclpy_env: PeerEnv, tmp_path: Path) -> None:
     """The measured cause of :data:`KILTED_GAP`: a ros_discovery_info entry whose gid is all zeros names a Cyclone
     node's endpoints on Kilted, not on Jazzy (which files them under the real participant gid, the GUID prefix
     with entity id 0x1c1). If a Fast DDS release fills participant_guid from the endpoint GUID, the Kilted half
     fails here and the strict xfail above turns XPASS."""
     node = f"{shlex.quote(sys.executable)} -c {shlex.quote(_GID_ZERO_NODE)} > {tmp_path}/st.out 2> {tmp_path}/st.err &"
     graph = _probe(rclpy_env, tmp_path, node)
-    expected = "ur3hanoi_station" if rclpy_env["DISTRO"] == "kilted" else "_CREATED_BY_BARE_DDS_APP_"
+    expected = "ur3hanoi_station" if rclpy_env.distro == "kilted" else "_CREATED_BY_BARE_DDS_APP_"
     assert {e["node"] for v in graph["publishers"].values() for e in v} == {expected}
 
 
@@ -163,16 +152,17 @@ def test_graph_shows_topics_types_hashes_and_qos(graph: dict[str, Any]) -> None:
     assert dig_in == 0 and abs(a_in0 - 1.05) < 0.1 and a_in1 == 0.0  # suction off, `real` profile
 
 
-def _student(tmp_path: Path, env: dict[str, str]) -> str:
+def _student(tmp_path: Path, env: PeerEnv) -> str:
     table = tmp_path / "lab2_data.yaml"
     from ur3hanoi import cli
 
     assert cli.main(["tables", "ur3e_sim", "--key", "sim_pos", "-o", str(table), "--convention", "course"]) == 0
     home = from_controller(np.array(load_station("ur3e_sim").q_home), "course")
-    return _peer(env, str(SUPPORT / "enme480_student.py"), str(table), "1", "3", ",".join(repr(float(x)) for x in home))
+    return env.peer_command(str(SUPPORT / "enme480_student.py"), str(table), "1", "3",
+                            ",".join(repr(float(x)) for x in home))
 
 
-def test_enme480_style_rclpy_program_solves_1_to_3(rclpy_env: dict[str, str], tmp_path: Path) -> None:
+def test_enme480_style_rclpy_program_solves_1_to_3(rclpy_env: PeerEnv, tmp_path: Path) -> None:
     result = in_netns(_station_script(tmp_path, _station(tmp_path), _student(tmp_path, rclpy_env)), 600.0, REPO)
     assert result.returncode == 0, result.stdout + result.stderr
     assert "station exit 0" in result.stderr
@@ -183,7 +173,7 @@ def test_enme480_style_rclpy_program_solves_1_to_3(rclpy_env: dict[str, str], tm
     assert all(math.isclose(d, 2.0, abs_tol=1e-9) for d in durations)  # the bridge's fixed 2 s moves
 
 
-def test_enme480_style_rclpy_program_halts_on_a_removed_block(rclpy_env: dict[str, str], tmp_path: Path) -> None:
+def test_enme480_style_rclpy_program_halts_on_a_removed_block(rclpy_env: PeerEnv, tmp_path: Path) -> None:
     script = _station_script(tmp_path, _station(tmp_path, "--remove-block 3"), _student(tmp_path, rclpy_env))
     result = in_netns(script, 300.0, REPO)
     assert result.returncode == 1, result.stdout + result.stderr

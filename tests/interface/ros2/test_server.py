@@ -301,7 +301,7 @@ def test_remove_block_and_spawn_over_dds_with_frames_rendered(tmp_path: Path) ->
     report, frames = tmp_path / "report.json", tmp_path / "frames"
     solve = "$UR3HANOI ros2-solve --start 1 --end 3 --blocks 1 --v 4 --a 4 --json"
     script = f"""
-MUJOCO_GL=egl $UR3HANOI ros2-station --timing honest --blocks 1 --frames {frames} --report {report} \\
+$UR3HANOI ros2-station --timing honest --blocks 1 --frames {frames} --report {report} \\
   > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
 wait_ready {tmp_path}/st.out || exit 90

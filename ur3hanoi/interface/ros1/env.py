@@ -29,8 +29,12 @@ ROS_PYTHON_DIR = Path("/usr/lib/python3/dist-packages")
 
 DEBIAN_PACKAGES: tuple[str, ...] = ("ros-core", "python3-rospy", "python3-genpy", "python3-std-msgs")
 """The Debian packages ur3hanoi's ROS commands need (``tools/ensure-system-deps.sh`` installs them)."""
+DRIVER_PACKAGES: tuple[str, ...] = ("python3-actionlib", "python3-actionlib-msgs", "python3-trajectory-msgs",
+                                    "python3-sensor-msgs")
+"""The Debian packages the official UR driver's interface needs besides (``--driver ur``)."""
 
 _ROS_MODULES: tuple[str, ...] = ("rospy", "genpy", "genmsg", "std_msgs")
+_DRIVER_MODULES: tuple[str, ...] = ("actionlib", "actionlib_msgs", "trajectory_msgs", "sensor_msgs")
 
 _INSTALL_HINT = (f"install Debian's packages {' '.join(DEBIAN_PACKAGES)} (as root: bash tools/ensure-system-deps.sh, "
                  f"or apt-get install -y {' '.join(DEBIAN_PACKAGES)})")
@@ -49,6 +53,20 @@ def ensure_ros_python() -> None:
     if missing:
         raise RosUnavailableError(f"ROS 1 Python modules {', '.join(missing)} are not importable (searched sys.path "
                                   f"and {folder}): {_INSTALL_HINT}")
+
+
+def ensure_driver_python() -> None:
+    """:func:`ensure_ros_python`, and actionlib, actionlib_msgs, trajectory_msgs and sensor_msgs (``--driver ur``).
+
+    Raises:
+        RosUnavailableError: a module is not importable; the message names the Debian packages.
+    """
+    ensure_ros_python()
+    missing = [m for m in _DRIVER_MODULES if importlib.util.find_spec(m) is None]
+    if missing:
+        raise RosUnavailableError(f"ROS 1 Python modules {', '.join(missing)} (for the UR driver's interface) are not "
+                                  f"importable: install Debian's packages {' '.join(DRIVER_PACKAGES)} (as root: bash "
+                                  f"tools/ensure-system-deps.sh, or apt-get install -y {' '.join(DRIVER_PACKAGES)})")
 
 
 def import_rospy() -> ModuleType:

@@ -175,10 +175,8 @@ class RosServer(ServerCore):
         """Start (or use) the master, run the node until SIGINT/SIGTERM or ``duration_s``; returns the report."""
         from ur3hanoi.interface.ros1.env import import_rospy, import_std_msgs
         from ur3hanoi.interface.ros1.master import RosCore, listen_env, master_pid
-        from ur3hanoi.interface.ros1.msgs import load_messages
         from ur3hanoi.interface.ros1.watch import MasterWatch, quick_shutdown
 
-        msgs = load_messages()
         rospy = self._rospy = import_rospy()
         std_msgs = import_std_msgs()
         # rospy's receiving threads hold the GIL for each message they decode: with the default 5 ms switch
@@ -195,14 +193,12 @@ class RosServer(ServerCore):
                 os.environ.update(env)
                 rospy.init_node(NODE_NAME, argv=[sys.argv[0]], disable_signals=True)
                 quick_shutdown()
-                pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
-                pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
-                rospy.Subscriber("/ur3/command", msgs.command, self.on_command, queue_size=100)
+                publish = self._open(rospy)
                 rospy.Subscriber("/ur3hanoi/spawn", std_msgs.Int32, self._on_spawn, queue_size=10)
                 rospy.Subscriber("/ur3hanoi/remove_block", std_msgs.Int32, self._on_remove, queue_size=10)
                 try:
                     with MasterWatch(self.master_uri, master_pid(self.master_uri) or 0, self._master_lost):
-                        self._run_loop(msgs, pub_pos, pub_grip)
+                        self._run_loop(publish)
                 finally:
                     rospy.signal_shutdown("ur3hanoi ros-station stopped")
                 self.close_sink()  # the report has the final frame counts
@@ -214,18 +210,34 @@ class RosServer(ServerCore):
             raise RosError(self._master_failed)
         return report
 
-    def _run_loop(self, msgs: Any, pub_pos: Any, pub_grip: Any) -> None:
-        w, opts = self.world, self.options
+    def _open(self, rospy: Any) -> Callable[[], None]:
+        """Advertise and subscribe the course's topics; returns the publish step of every control cycle."""
+        from ur3hanoi.interface.ros1.msgs import load_messages
+
+        msgs = load_messages()
+        w = self.world
+        pub_pos = rospy.Publisher("/ur3/position", msgs.position, queue_size=10)
+        pub_grip = rospy.Publisher("/ur3/gripper_input", msgs.gripper_input, queue_size=10)
+        rospy.Subscriber("/ur3/command", msgs.command, self.on_command, queue_size=100)
 
         def publish() -> None:
             fb = w.feedback()
             pub_pos.publish(msgs.position(position=[float(x) for x in w.q], isReady=self.controller.ready))
             pub_grip.publish(msgs.gripper_input(DIGIN=fb.digin, AIN0=fb.ain0, AIN1=0.0))
 
+        return publish
+
+    def _ready_detail(self) -> str:
+        """What the ready line says after the station's name and blocks."""
+        w = self.world
+        return f"{1.0 / w.config.period_s:g} Hz, suction profile {w.cup.profile.name}"
+
+    def _run_loop(self, publish: Callable[[], None]) -> None:
+        w, opts = self.world, self.options
         st = self.station
         spawned = w.n_blocks - len(w.removed)  # --remove-block leaves one out
         ready = (f"{READY_LINE} on {self.master_uri}: {st.name}, {spawned} blocks on tower {opts.start + 1}, "
-                 f"{1.0 / w.config.period_s:g} Hz, suction profile {w.cup.profile.name} (pid {os.getpid()})")
+                 f"{self._ready_detail()} (pid {os.getpid()})")
         # The ROS callbacks fill the inbox in rospy's threads: nothing to receive here.
         self.loop(ready, lambda: None, publish,
                   running=lambda: self._master_failed is None and not self._rospy.is_shutdown())

@@ -1,0 +1,60 @@
+"""``ros-station --driver ur`` over a real roscore (marked ``ros``, real time), used by clients written as others
+write them: the UR driver's own integration test client (ported), a MoveIt-style client, a course-bridge-style
+client, and ``set_io`` clients of both ``ur_msgs`` texts -- every one through Debian's actionlib and rospy."""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Iterator
+
+import pytest
+
+from tests.support import SUPPORT
+from tests.support.ros_support import Station, free_port, requires_ros, ros_env, roscore, run, station
+
+pytestmark = [pytest.mark.ros, requires_ros]
+
+
+@pytest.fixture(scope="module")
+def driver_station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Station, dict[str, str]]]:
+    tmp = tmp_path_factory.mktemp("ur_station")
+    env = ros_env(free_port(), tmp)
+    with roscore(env), station(env, tmp, "--driver", "ur") as st:
+        yield st, env
+
+
+def client(env: dict[str, str], kind: str) -> dict[str, object]:
+    result = run([sys.executable, str(SUPPORT / "ur_driver_clients.py"), kind], env, 120.0)
+    out = json.loads(result.stdout.strip().splitlines()[-1]) if result.stdout.strip() else {}
+    assert result.returncode == 0, (kind, out, result.stderr[-2000:])
+    return out
+
+
+def test_set_io_serves_both_ur_msgs_texts(driver_station):
+    out = client(driver_station[1], "set-io")
+    assert out == {"ok": True, "noetic_1.4": True, "ur_msgs_1.3": True, "md5_any": True, "refused_pin_18": True}
+
+
+def test_a_moveit_style_client(driver_station):
+    out = client(driver_station[1], "moveit")
+    assert out["code"] == 0 and out["final_error_rad"] < 0.01
+
+
+def test_a_course_bridge_style_client_movej_per_waypoint(driver_station):
+    out = client(driver_station[1], "bridge")
+    assert out["codes"] == [0, 0, 0]
+
+
+def test_the_ur_drivers_own_integration_test_client(driver_station):
+    st, env = driver_station
+    out = client(env, "integration")
+    assert out["simple"] == [0, ""]
+    assert out["illegal"] == [-1, "Trajectory message contains waypoints that are not strictly increasing in time."]
+    assert out["scaled"] == [0, ""] and out["scaled_tight"] == [-5, ""]
+    report = st.snapshot()
+    goals = report["goals"]
+    assert goals["rejected"] >= 1 and goals["aborted"] >= 1
+    late = [g for g in report["goal_records"] if g.get("result") == "GOAL_TOLERANCE_VIOLATED (-5)"]
+    assert late and late[-1]["lateness_s"] > 0.0
+    assert report["driver"]["profile"] == "ros1_scaled" and report["control"]["rate_hz"] == 125.0

@@ -1,0 +1,155 @@
+"""The plan on the UR driver, on the CPU clock: the neutral client (:func:`run_driver_solve`) against the neutral
+station through the loopback transport -- a solve, its timing, the halts, the driver's errors, a far start, the
+client's timeout under the speed slider."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from functools import cache
+
+import numpy as np
+import pytest
+
+from tests.support.driver_helpers import goal, send, station
+from ur3hanoi.errors import DriverError, SuctionFaultError
+from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverState
+from ur3hanoi.interface.urdriver.facts import ErrorCode
+from ur3hanoi.interface.urdriver.loopback import LoopbackTransport
+from ur3hanoi.interface.urdriver.solve import DriverSolveConfig, run_driver_solve
+from ur3hanoi.plan import Plan, PlanConfig, plan_solve
+
+
+@cache
+def plan(n_blocks: int) -> Plan:
+    return plan_solve(station().station, 0, 2, n_blocks, PlanConfig())
+
+
+def solve(n_blocks: int, transport_class=LoopbackTransport, config: DriverSolveConfig | None = None, **options):
+    st = station(n_blocks=n_blocks, **options)
+    tr = transport_class(st)
+    tr.connect()
+    lines: list[str] = []
+    try:
+        result = run_driver_solve(tr, plan(n_blocks), st.station.wiring, config, log=lines.append)
+    except Exception as exc:
+        exc.station, exc.lines = st, lines  # type: ignore[attr-defined]
+        raise
+    return result, st, lines
+
+
+def slots(st) -> dict[int, tuple[int | None, int | None]]:
+    return {b["block"]: (b["tower"], b["height"]) for b in st.report()["final"]["blocks"]}
+
+
+def test_a_three_block_solve_runs_the_plan_in_its_own_time():
+    result, st, lines = solve(3)
+    p = plan(3)
+    assert slots(st) == {1: (3, 1), 2: (3, 2), 3: (3, 3)}
+    assert result.goals == 15 and result.approach_s == 0.0 and lines == []
+    # The executed time is the plan's: one control cycle per goal more, the dwells as planned.
+    assert result.executed_s == pytest.approx(p.duration_s, rel=0.02)
+    report = st.report()
+    assert report["goals"]["succeeded"] == 15 and report["goals"]["max_lateness_s"] <= 0.02
+    assert report["final"]["at_home"] and not report["final"]["suction_on"]
+
+
+def test_at_half_speed_the_motion_takes_twice_as_long():
+    result, st, _ = solve(1, speed_scaling=0.5)
+    p = plan(1)
+    assert slots(st)[1] == (3, 1)
+    assert result.executed_s == pytest.approx(2 * p.motion_s + p.dwell_total_s, rel=0.02)
+
+
+def test_a_missing_block_halts_cancel_suction_off_home():
+    with pytest.raises(SuctionFaultError, match=r"move 1/7: red block 3 is missing at tower 1 height 3 \(DI0=0, "
+                                                r"AI0=1\.4\d V\); halted, suction off, arm returned home") as err:
+        solve(3, removed=2)
+    report = err.value.station.report()  # type: ignore[attr-defined]
+    assert report["final"]["at_home"] and not report["final"]["suction_on"]
+
+
+def test_a_dropped_block_halts_within_one_control_cycle():
+    with pytest.raises(SuctionFaultError, match="red block 3 was dropped while carrying it from tower 1 to tower 3") \
+            as err:
+        solve(3, drop_on_grasp=0)
+    report = err.value.station.report()  # type: ignore[attr-defined]
+    (halt,) = report["halts"]
+    assert halt["cycles"] == 1  # io_states of cycle k says so; the cancel is handled in cycle k + 1
+    assert report["goals"]["canceled"] == 1 and report["final"]["at_home"] and not report["final"]["suction_on"]
+
+
+class HoldingTransport(LoopbackTransport):
+    """Holds the arm 60 cycles into the first goal (an obstacle)."""
+
+    def wait(self, timeout_s: float) -> None:
+        if self.cycles == 60:
+            self.station.on_hold(3.0)
+        super().wait(timeout_s)
+
+
+class RenamingTransport(LoopbackTransport):
+    """Sends every goal with a joint the controller does not have."""
+
+    def send_goal(self, g):
+        return super().send_goal(replace(g, joint_names=(*g.joint_names[:5], "gripper_joint")))
+
+
+def test_an_aborted_goal_ends_the_solve_with_the_drivers_code_suction_off():
+    with pytest.raises(DriverGoalError, match=r"ended goal 1/3 \(approach of move 1\): aborted: "
+                                              r"PATH_TOLERANCE_VIOLATED \(-4\) \(no error string\); suction off") as e:
+        solve(1, HoldingTransport)
+    assert e.value.result.code == ErrorCode.PATH_TOLERANCE_VIOLATED
+    assert not e.value.station.world.suction_on  # type: ignore[attr-defined]
+
+
+def test_a_rejected_goal_ends_the_solve_with_the_drivers_code():
+    with pytest.raises(DriverGoalError, match=r"rejected goal 1/3 .*: rejected: INVALID_JOINTS \(-2\)"):
+        solve(1, RenamingTransport)
+
+
+class MovedFirst(LoopbackTransport):
+    """The arm is 0.3 rad from home on joint 1 when the solve starts."""
+
+    def connect(self) -> None:
+        super().connect()
+        q = self.station.world.q
+        assert send(self, goal(q + np.array([0.3, 0, 0, 0, 0, 0]), 1.0, q))[0].status == "succeeded"
+
+
+def test_an_arm_far_from_the_plans_start_is_brought_there_slowly_or_refused():
+    result, st, lines = solve(1, MovedFirst)
+    assert lines[0].startswith("the arm is 0.300 rad from where the plan starts (shoulder_pan_joint): moving there "
+                               "first at 25 % speed")
+    assert result.approach_s > 0.5 and slots(st)[1] == (3, 1)
+    with pytest.raises(DriverError, match=r"the arm is 0\.300 rad from where the plan starts \(shoulder_pan_joint\): "
+                                          r"expected within 0\.01 rad"):
+        solve(1, MovedFirst, DriverSolveConfig(far_start="refuse"))
+
+
+class FullSpeedLiar(LoopbackTransport):
+    """Reports a speed scaling of 1 whatever the slider says."""
+
+    def latest(self) -> DriverState:
+        return replace(super().latest(), speed_scaling=1.0)
+
+
+def test_the_clients_goal_timeout_counts_the_speed_scaling():
+    result, st, _ = solve(1, config=DriverSolveConfig(goal_margin_s=0.5), speed_scaling=0.3)
+    assert slots(st)[1] == (3, 1) and result.executed_s > 2.5 * plan(1).motion_s
+    with pytest.raises(DriverError, match=r"goal 1/3 \(approach of move 1\) did not finish within \d+\.\d s of "
+                                          r"trajectory time .*: canceled, suction off"):
+        solve(1, FullSpeedLiar, DriverSolveConfig(goal_margin_s=0.5), speed_scaling=0.3)
+
+
+def test_a_hand_recorded_tables_plan_runs_too():
+    """``--table``: the plan through the table's waypoints (rest to rest, as the lab program moves) is cut at its
+    dwells and run the same way."""
+    from ur3hanoi.plan import plan_table
+    from ur3hanoi.tables.ik_table import generate_table
+
+    st = station(n_blocks=1)
+    p = plan_table(st.station, generate_table(st.station).q, 0, 2, 1, PlanConfig())
+    tr = LoopbackTransport(st)
+    tr.connect()
+    result = run_driver_solve(tr, p, st.station.wiring)
+    assert slots(st) == {1: (3, 1)} and result.executed_s == pytest.approx(p.duration_s, rel=0.02)

@@ -1,0 +1,19 @@
+"""The official Universal Robots drivers' interface, middleware-neutral: what a stand-in serves and a client sends.
+
+Modules, one concept each (importing this package needs neither ROS nor MuJoCo):
+
+- :mod:`~ur3hanoi.interface.urdriver.facts`: names, error codes, the IO pin mapping.
+- :mod:`~ur3hanoi.interface.urdriver.profile`: the controllers' defaults and the ROS 1 / ROS 2 differences.
+- :mod:`~ur3hanoi.interface.urdriver.spline`: the joint trajectory controller's linear, cubic and quintic segments.
+- :mod:`~ur3hanoi.interface.urdriver.goal`: a ``FollowJointTrajectory`` goal and the checks before it is accepted.
+- :mod:`~ur3hanoi.interface.urdriver.follower`: the scaled joint trajectory controller (goals, time, tolerances).
+- :mod:`~ur3hanoi.interface.urdriver.io`: ``set_io`` and ``io_states``.
+- :mod:`~ur3hanoi.interface.urdriver.plan_goals`: a Ruckig plan as goals, cut at its suction dwells.
+- :mod:`~ur3hanoi.interface.urdriver.records`: what the station's report records (goals, IO calls, halts).
+- :mod:`~ur3hanoi.interface.urdriver.client`: what a client's binding provides (``DriverTransport``).
+- :mod:`~ur3hanoi.interface.urdriver.station`: the station without its transport (``DriverStation``).
+- :mod:`~ur3hanoi.interface.urdriver.solve`: the plan on the driver with the lab's checks (``run_driver_solve``).
+- :mod:`~ur3hanoi.interface.urdriver.loopback`: client and station in one process on the CPU clock.
+
+Bindings: :mod:`ur3hanoi.interface.ros1` (``ur_server``, ``ur_client``) and :mod:`ur3hanoi.interface.ros2`.
+"""

@@ -1,0 +1,336 @@
+"""The UR driver's scaled joint trajectory controller, without a middleware: goals in, a desired joint state per
+control cycle out, results by the controller's rules.
+
+:class:`TrajectoryFollower` is a port of ros_controllers' ``JointTrajectoryController`` (noetic-devel:
+``joint_trajectory_controller_impl.h``, ``init_joint_trajectory.h``, ``tolerances.h``, ``stop_trajectory_builder.h``)
+with Universal Robots' scaled update (``scaled_joint_trajectory_controller.h``); what differs on ROS 2 comes from
+its :class:`~ur3hanoi.interface.urdriver.profile.ControllerProfile`.
+
+- **Time.** The controller's clock ("uptime") advances by ``period x speed scaling`` every cycle, so a slider at
+  50 % or a robot slowing itself stretches the trajectory; the desired state is the trajectory sampled there.
+- **A new goal** (:meth:`TrajectoryFollower.submit`) is checked (:func:`~ur3hanoi.interface.urdriver.goal.check_goal`;
+  then the points' times: a goal all in the past is INVALID_GOAL "Dropping all N trajectory point(s) ..."), its
+  joints reordered to the controller's, and spliced in at the next cycle: points not after that time are dropped
+  (a first point at ``time_from_start`` 0 silently), a bridge segment runs from the current desired state (position,
+  velocity, acceleration) to the first point left, then one segment per pair of points
+  (:mod:`~ur3hanoi.interface.urdriver.spline`). It preempts the running goal. An empty trajectory stops the arm.
+- **Every cycle** (:meth:`TrajectoryFollower.update`) the error is ``desired - actual`` (positions by the shortest
+  angle). While the active goal's trajectory runs, a joint beyond its path tolerance aborts it with
+  PATH_TOLERANCE_VIOLATED; once it has ended, a joint inside its goal tolerances (position, and velocity below
+  ``stopped_velocity_tolerance``) counts as arrived, and the goal succeeds when all have; one still outside after
+  the goal time aborts it with GOAL_TOLERANCE_VIOLATED. Tolerances: the profile's defaults, a goal's own > 0
+  replacing them, < 0 switching them off.
+- **Cancel** (:meth:`TrajectoryFollower.cancel`) ends the active goal and ramps the desired state to rest: the
+  controller's stop trajectory (``stop_trajectory_duration``, a quintic from the current desired position and
+  velocity), lengthened where a joint would decelerate faster than its acceleration limit allows; then it holds.
+
+The results are read with :meth:`TrajectoryFollower.take_outcomes`. Nothing here knows ROS, threads or MuJoCo.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Hashable, Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from ur3hanoi.arrays import FloatArray
+from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ErrorCode
+from ur3hanoi.interface.urdriver.goal import Rejection, TrajectoryGoal, TrajectoryPoint, check_goal
+from ur3hanoi.interface.urdriver.profile import ControllerProfile
+from ur3hanoi.interface.urdriver.spline import JointState, Segment, find_segment, segment
+
+Status = Literal["succeeded", "aborted", "preempted", "canceled"]
+BoolArray = npt.NDArray[np.bool_]
+TIME_RESOLUTION_S = 1e-9
+"""Times closer than this [s] are equal: ROS times are whole nanoseconds (the controllers compare them exactly)."""
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """How a goal ended: ``status``, the result's ``code`` and ``error_string``, at controller cycle ``cycle``;
+    ``max_path_error_rad``: its largest position error while its trajectory ran."""
+
+    key: Hashable
+    status: Status
+    code: ErrorCode
+    error_string: str
+    cycle: int
+    max_path_error_rad: float = 0.0
+
+
+@dataclass(frozen=True)
+class Feedback:
+    """The action feedback of one cycle: desired and actual joint states and their error (controller order)."""
+
+    desired: JointState
+    actual_q: FloatArray
+    actual_qd: FloatArray
+    error_q: FloatArray
+    error_qd: FloatArray
+
+
+@dataclass
+class _Tolerances:
+    """Per joint [rad, rad/s], 0 = not checked. (Acceleration tolerances are never violated: the controller's
+    acceleration error is always 0.)"""
+
+    path: FloatArray
+    path_v: FloatArray
+    goal: FloatArray
+    goal_v: FloatArray
+    goal_time_s: float
+
+
+@dataclass
+class _Active:
+    key: Hashable
+    tolerances: _Tolerances
+    end_s: float  # controller time of the trajectory's last point
+    accepted_cycle: int
+    arrived: BoolArray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    max_path_error: float = 0.0
+
+
+def _override(value: float, default: float) -> float:
+    """``updateStateTolerances``: > 0 replaces, < 0 switches off (0), 0 keeps."""
+    return value if value > 0.0 else 0.0 if value < 0.0 else default
+
+
+def shortest_angle(a: FloatArray) -> FloatArray:
+    """``angles::shortest_angular_distance``: ``a`` wrapped into [-pi, pi)."""
+    return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
+class TrajectoryFollower:
+    """The scaled joint trajectory controller (see the module docstring).
+
+    Args:
+        profile: the controller's defaults and version rules.
+        q0: the arm's position at start [rad] (controller joint order), held until the first goal.
+        a_max: the joints' acceleration limits [rad/s^2], for the stop ramp on cancel.
+        joints: the controller's joint names, in its order.
+    """
+
+    def __init__(self, profile: ControllerProfile, q0: Sequence[float] | FloatArray, a_max: Sequence[float],
+                 joints: tuple[str, ...] = CONTROLLER_JOINTS) -> None:
+        self.profile = profile
+        self.joints = joints
+        self.n = len(joints)
+        self.a_max = np.asarray(a_max, dtype=float)
+        q = np.array(q0, dtype=float)
+        z = np.zeros(self.n)
+        self.uptime = 0.0  # controller time [s]
+        self.cycle = 0  # control cycles run
+        self._last_period = 0.0  # the scaled period of the last cycle [s]
+        self.trajectory: list[Segment] = [segment(0.0, JointState(q, z, z), 0.0, JointState(q, z, z))]
+        self.desired = JointState(q.copy(), z.copy(), z.copy())
+        self.active: _Active | None = None
+        self._outcomes: list[Outcome] = []
+        self._feedback: Feedback | None = None
+        self.running = True
+
+    # ------------------------------------------------------------------------------------------------ goals
+    def _tolerances(self, goal: TrajectoryGoal) -> _Tolerances:
+        p = self.profile
+        n = self.n
+        tol = _Tolerances(np.full(n, p.path_tolerance_rad), np.zeros(n), np.full(n, p.goal_tolerance_rad),
+                          np.full(n, p.stopped_velocity_tolerance), p.goal_time_s)
+        index = {name: i for i, name in enumerate(self.joints)}
+        for overrides, q_tol, v_tol in ((goal.path_tolerance, tol.path, tol.path_v),
+                                        (goal.goal_tolerance, tol.goal, tol.goal_v)):
+            for t in overrides:
+                if t.name in index:
+                    i = index[t.name]
+                    q_tol[i], v_tol[i] = _override(t.position, q_tol[i]), _override(t.velocity, v_tol[i])
+        tol.goal_time_s = _override(goal.goal_time_tolerance_s, tol.goal_time_s)
+        return tol
+
+    @staticmethod
+    def _point(p: TrajectoryPoint, order: list[int]) -> JointState:
+        """A point's fields in the controller's joint order (absent ones None)."""
+        def pick(values: tuple[float, ...]) -> FloatArray | None:
+            return np.array([values[k] for k in order], dtype=float) if values else None
+
+        return JointState(np.array([p.positions[k] for k in order], dtype=float), pick(p.velocities),
+                          pick(p.accelerations))
+
+    def submit(self, key: Hashable, goal: TrajectoryGoal) -> Rejection | None:
+        """Accept ``goal`` (it preempts the active one) or say why not. It starts at the next :meth:`update`."""
+        if not self.running:
+            text = "Can't accept new commands. Controller is not running."
+            return Rejection(ErrorCode.INVALID_GOAL, text, text)
+        rejection = check_goal(goal, self.profile, self.joints)
+        if rejection is not None:
+            return rejection
+        now = self.uptime + self._last_period  # the next update's controller time
+        if not goal.points:
+            self._preempt()
+            self.active = _Active(key, self._tolerances(goal), now, self.cycle, np.zeros(self.n, dtype=bool))
+            self._stop(now)
+            self.active.end_s = self.trajectory[-1].end_s
+            return None
+        start = now + (goal.start_in_s or 0.0)
+        times = [start + p.time_from_start_s for p in goal.points]
+        first = next((k for k, t in enumerate(times) if t > now + TIME_RESOLUTION_S), None)
+        if first is None:
+            n = len(goal.points)
+            text = (f"Dropping all {n} trajectory point(s), as they occur before the current time.\n"
+                    f"Last point is {now - times[-1]:f}s in the past.")
+            return Rejection(ErrorCode.INVALID_GOAL, text, text.replace("\n", " "))
+        order = [goal.joint_names.index(j) for j in self.joints]
+        states = [self._point(p, order) for p in goal.points]
+        bridge_from = max(start, now)
+        keep = self.trajectory[find_segment(self.trajectory, now):find_segment(self.trajectory, bridge_from) + 1]
+        here = JointState(*self._sample(bridge_from))
+        new = [*keep, segment(bridge_from, here, times[first], states[first])]
+        new += [segment(times[k], states[k], times[k + 1], states[k + 1]) for k in range(first, len(states) - 1)]
+        self._preempt()
+        self.trajectory = new
+        self.active = _Active(key, self._tolerances(goal), times[-1], self.cycle, np.zeros(self.n, dtype=bool))
+        return None
+
+    def _preempt(self) -> None:
+        if self.active is not None:
+            self._end("preempted", ErrorCode.SUCCESSFUL, "")
+
+    def set_running(self, running: bool) -> None:
+        """Start or stop the controller (the driver's ``controller_stopper`` while the robot program is stopped on
+        the pendant): stopping preempts the active goal and brings the arm to rest; a stopped controller refuses
+        goals (INVALID_GOAL "Can't accept new commands. Controller is not running.")."""
+        if self.running and not running:
+            self._preempt()
+            self._stop(self.uptime)
+        self.running = running
+
+    def cancel(self, key: Hashable) -> bool:
+        """Cancel goal ``key`` if it is the active one (True): it ends "canceled" and the arm ramps to rest."""
+        if self.active is None or self.active.key != key:
+            return False
+        self._end("canceled", ErrorCode.SUCCESSFUL, "")
+        self._stop(self.uptime)
+        return True
+
+    def _end(self, status: Status, code: ErrorCode, text: str) -> None:
+        assert self.active is not None
+        self._outcomes.append(Outcome(self.active.key, status, code, text, self.cycle, self.active.max_path_error))
+        self.active = None
+
+    def take_outcomes(self) -> list[Outcome]:
+        """The goals that ended since the last call, in order."""
+        out, self._outcomes = self._outcomes, []
+        return out
+
+    # ------------------------------------------------------------------------------------------------- stop
+    def _stop(self, t0: float) -> None:
+        """Replace the trajectory by the ramp to rest from the desired state at controller time ``t0``."""
+        assert self.desired.qd is not None  # the desired state always has every field
+        self.trajectory = [stop_ramp(self.desired.q, self.desired.qd, t0, self.profile.stop_trajectory_s, self.a_max)]
+
+    # ---------------------------------------------------------------------------------------------- cycle
+    def _sample(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        return self.trajectory[find_segment(self.trajectory, t)].sample(t)
+
+    def update(self, q: FloatArray, qd: FloatArray, period_s: float, scaling: float) -> JointState:
+        """One control cycle of ``period_s`` [s] at speed ``scaling`` (0..1) with the arm at ``q`` [rad], ``qd``
+        [rad/s]: advance the clock, sample the desired state, check the active goal. Returns the desired state
+        (its velocity and acceleration in controller time: times ``scaling`` and ``scaling**2`` on the wall)."""
+        self.cycle += 1
+        self._last_period = period_s * scaling
+        t = self.uptime + (period_s if self.profile.sample_one_period_ahead else self._last_period)
+        self.uptime += self._last_period
+        index = find_segment(self.trajectory, t)
+        seg = self.trajectory[index]
+        p, v, a = seg.sample(t)
+        self.desired = JointState(p, v, a)
+        err_q, err_qd = shortest_angle(p - q), v - qd
+        active = self.active
+        self._feedback = None
+        if active is not None:
+            self._feedback = Feedback(self.desired, q.copy(), qd.copy(), err_q, err_qd)
+            self._check(active, seg, index == len(self.trajectory) - 1, err_q, err_qd)
+        return self.desired
+
+    def _check(self, active: _Active, seg: Segment, last: bool, err_q: FloatArray, err_qd: FloatArray) -> None:
+        tol, prof = active.tolerances, self.profile
+        if self.uptime < seg.end_s - TIME_RESOLUTION_S:
+            active.max_path_error = max(active.max_path_error, float(np.max(np.abs(err_q))))
+            bad = _outside(err_q, err_qd, tol.path, tol.path_v)
+            if bad is not None:
+                self._end("aborted", ErrorCode.PATH_TOLERANCE_VIOLATED,
+                          prof.path_error.format(joint=self.joints[bad], error=float(err_q[bad]), late=0.0))
+                if prof.hold_on_path_abort:
+                    self._stop(self.uptime)
+            return
+        if not last:
+            return
+        inside = _inside(err_q, err_qd, tol.goal, tol.goal_v)
+        late = self.uptime - seg.end_s
+        out_of_time = (not (prof.goal_time_zero_waits and tol.goal_time_s == 0.0)
+                       and late >= tol.goal_time_s - TIME_RESOLUTION_S)
+        if prof.validation == "ros1":  # per joint, in order; a joint once inside stays counted as arrived
+            for i in range(self.n):
+                if inside[i]:
+                    active.arrived[i] = True
+                elif out_of_time:
+                    self._abort_late(i, err_q, late)
+                    return
+            if np.all(active.arrived):
+                self._end("succeeded", ErrorCode.SUCCESSFUL, prof.success_text)
+        elif np.all(inside):
+            self._end("succeeded", ErrorCode.SUCCESSFUL, prof.success_text)
+        elif out_of_time:
+            self._abort_late(int(np.flatnonzero(~inside)[0]), err_q, late)
+
+    def _abort_late(self, joint: int, err_q: FloatArray, late: float) -> None:
+        prof = self.profile
+        self._end("aborted", ErrorCode.GOAL_TOLERANCE_VIOLATED,
+                  prof.goal_error.format(joint=self.joints[joint], error=float(err_q[joint]), late=late))
+        if prof.hold_on_path_abort:
+            self._stop(self.uptime)
+
+    # ------------------------------------------------------------------------------------------- reading
+    def feedback(self) -> Feedback | None:
+        """The active goal's feedback of the last cycle (None without an active goal)."""
+        return self._feedback
+
+    @property
+    def max_path_error(self) -> float:
+        """The active goal's largest position error [rad] while its trajectory ran (0 without one)."""
+        return 0.0 if self.active is None else self.active.max_path_error
+
+
+def stop_ramp(q: FloatArray, qd: FloatArray, t0: float, duration_s: float, a_max: FloatArray) -> Segment:
+    """The controller's stop trajectory (``StopTrajectoryBuilder``) from position ``q`` [rad] and velocity ``qd``
+    [rad/s] at controller time ``t0``: the quintic to the middle of the mirror segment that returns to ``q`` at
+    ``-qd`` after twice ``duration_s``, where the velocity is 0; lengthened where a joint would decelerate faster
+    than ``a_max`` [rad/s^2] (the real robot limits its own). ``duration_s`` 0 or an arm at rest: hold ``q``."""
+    z = np.zeros(len(q))
+    T = duration_s
+    if T <= 0.0 or not np.any(qd):
+        return segment(t0, JointState(q, z, z), t0, JointState(q, z, z))
+    for _ in range(2):  # the second pass checks the lengthened ramp
+        mirror = segment(t0, JointState(q, qd, z), t0 + 2.0 * T, JointState(q, -qd, z))
+        ramp = segment(t0, JointState(q, qd, z), t0 + T, JointState(*mirror.sample(t0 + T)))
+        peak = np.max(np.abs([ramp.sample(t0 + T * u)[2] for u in np.linspace(0.0, 1.0, 21)]), axis=0)
+        ratio = float(np.max(peak / a_max))
+        if ratio <= 1.0:
+            break
+        T *= ratio
+    return ramp
+
+
+def _outside(err_q: FloatArray, err_qd: FloatArray, tol_q: FloatArray, tol_qd: FloatArray) -> int | None:
+    """The first joint outside its (non-zero) tolerances, or None (``checkStateTolerancePerJoint``)."""
+    bad = ((tol_q > 0.0) & (np.abs(err_q) > tol_q)) | ((tol_qd > 0.0) & (np.abs(err_qd) > tol_qd))
+    hits = np.flatnonzero(bad)
+    return int(hits[0]) if hits.size else None
+
+
+def _inside(err_q: FloatArray, err_qd: FloatArray, tol_q: FloatArray, tol_qd: FloatArray) -> BoolArray:
+    return ~(((tol_q > 0.0) & (np.abs(err_q) > tol_q)) | ((tol_qd > 0.0) & (np.abs(err_qd) > tol_qd)))
+
+
+__all__ = ["Feedback", "Outcome", "TrajectoryFollower", "shortest_angle", "stop_ramp"]

@@ -1,0 +1,259 @@
+"""The Ruckig plan on the official UR driver, with the lab's suction checks: ``ros-solve --driver ur`` and
+``ros2-solve --driver ur``, whatever the middleware.
+
+:func:`run_driver_solve` executes a :class:`ur3hanoi.plan.Plan` through a
+:class:`~ur3hanoi.interface.urdriver.client.DriverTransport`:
+
+1. **Start.** The arm's joint states (by name) are compared with where the plan starts: within
+   ``start_tolerance_rad`` it starts; farther, it is first brought there by a slow goal (``approach_speed`` of the
+   limits; the line says so), or the solve refuses with the distance (``far_start="refuse"``). Never a jump.
+2. **Motion goals.** Each stretch of the plan between two suction dwells is one ``FollowJointTrajectory`` goal with
+   the plan's own samples (:mod:`~ur3hanoi.interface.urdriver.plan_goals`), sent when the previous one succeeded. The
+   client waits with its own timeout: the goal's duration plus ``goal_margin_s`` of *trajectory* time, which advances
+   with the speed scaling the driver reports (a slider at 50 % doubles the wall time allowed; paused, it waits).
+3. **Suction.** At a grasp dwell ``set_io`` switches the calibration's output on, then the vacuum switch input
+   must read 1 within ``grasp_timeout_s`` and the dwell lasts at least as planned; at a release dwell the output goes
+   off for the planned dwell (and until the switch clears, at most ``release_timeout_s``). While a block is carried
+   (lift, carry, place) every ``io_states`` is checked; the first without the block cancels the running goal.
+4. **Halt** (a block missing at a grasp or dropped in a carry): cancel, suction off, the arm waits at rest, then a
+   slow goal home; :class:`~ur3hanoi.errors.SuctionFaultError` (exit 3), one line as the lab program's.
+5. **Errors.** A goal the controller rejects or aborts: suction off,
+   :class:`~ur3hanoi.interface.urdriver.client.DriverGoalError` (exit 2) with the driver's code and error string; a
+   goal past its timeout: canceled, suction off,
+   :class:`~ur3hanoi.errors.DriverError`; joint states that stop: the same.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from ur3hanoi.arrays import FloatArray
+from ur3hanoi.errors import DriverError, SuctionFaultError
+from ur3hanoi.hanoi import Move, block_colour
+from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverTransport, GoalHandle
+from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, FUN_SET_DIGITAL_OUT
+from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
+from ur3hanoi.interface.urdriver.plan_goals import Stretch, move_goal, plan_stretches
+from ur3hanoi.plan import Plan
+from ur3hanoi.station.suction_wiring import SuctionWiring
+
+
+@dataclass(frozen=True)
+class DriverSolveConfig:
+    """How the client drives (times [s], angles [rad]; see the module docstring)."""
+
+    grasp_timeout_s: float = 1.0
+    release_timeout_s: float = 0.5
+    start_tolerance_rad: float = 0.01
+    far_start: Literal["approach", "refuse"] = "approach"
+    approach_speed: float = 0.25
+    home_speed: float = 0.25
+    goal_margin_s: float = 2.0
+    state_timeout_s: float = 2.0
+    rest_timeout_s: float = 3.0
+    poll_s: float = 0.002
+
+
+@dataclass(frozen=True)
+class DriverSolveResult:
+    """A completed solve: the moves, the goals sent, the wall times [s] of the whole, of the approach to the plan's
+    start and of the plan's execution (to compare with the plan's own cycle time [s])."""
+
+    moves: tuple[Move, ...]
+    goals: int
+    wall_time_s: float
+    approach_s: float
+    executed_s: float
+    plan_duration_s: float
+
+
+class _HaltError(Exception):
+    def __init__(self, kind: str) -> None:
+        super().__init__(kind)
+        self.kind = kind
+
+
+class _Solve:
+    """One run of :func:`run_driver_solve`: the state its steps share."""
+
+    def __init__(self, transport: DriverTransport, plan: Plan, wiring: SuctionWiring, cfg: DriverSolveConfig,
+                 say: Callable[[str], None]) -> None:
+        self.tr, self.plan, self.wiring, self.cfg, self.say = transport, plan, wiring, cfg, say
+        self.goals = 0
+        self.n_goals = 0
+
+    # ------------------------------------------------------------------------------------------ reading
+    def held(self) -> bool:
+        io = self.tr.latest().io
+        return io is not None and io.digital_in[self.wiring.switch_input]
+
+    def feedback_text(self) -> str:
+        io, w = self.tr.latest().io, self.wiring
+        if io is None:
+            return "no io_states"
+        return f"DI{w.switch_input}={int(io.digital_in[w.switch_input])}, AI{w.sensor_input}=" \
+               f"{io.analog_in[w.sensor_input][1]:.2f} V"
+
+    def q(self) -> FloatArray:
+        st = self.tr.latest()
+        if st.q is None:
+            raise DriverError(f"no joint states from the driver on {self.tr.where}")
+        return st.q
+
+    def sleep(self, seconds: float, until: Callable[[], bool] = lambda: False) -> bool:
+        """Wait ``seconds`` (watching the transport) or until ``until()``: True when it came true."""
+        end = self.tr.now() + seconds
+        while True:
+            if until():
+                return True
+            left = end - self.tr.now()
+            if left <= 0.0:
+                return False
+            self.tr.wait(min(self.cfg.poll_s, left))
+
+    # ------------------------------------------------------------------------------------------ goals
+    def run_goal(self, goal: TrajectoryGoal, what: str, carrying: bool = False) -> None:
+        """Send ``goal`` and wait for its success, watching the suction while ``carrying``."""
+        cfg, tr = self.cfg, self.tr
+        self.goals += 1
+        label = f"goal {self.goals}" + (f"/{self.n_goals}" if self.goals <= self.n_goals else "") + f" ({what})"
+        handle = tr.send_goal(goal)
+        allowed = goal.points[-1].time_from_start_s + cfg.goal_margin_s if goal.points else cfg.goal_margin_s
+        tau, last = 0.0, self.tr.now()
+        while not handle.done():
+            tr.wait(cfg.poll_s)
+            now, st = self.tr.now(), tr.latest()
+            tau += (now - last) * (1.0 if st.speed_scaling is None else st.speed_scaling)
+            last = now
+            if carrying and not self.held():
+                self._cancel(handle)
+                raise _HaltError("dropped")
+            if now - st.t_q > cfg.state_timeout_s:
+                self._cancel(handle)
+                self.suction(False)
+                raise DriverError(f"joint states stopped: none from the driver on {tr.where} for "
+                                  f"{now - st.t_q:.1f} s during {label}; is the driver still running?")
+            if tau > allowed:
+                self._cancel(handle)
+                self.suction(False)
+                raise DriverError(f"{label} did not finish within {allowed:.1f} s of trajectory time (the speed "
+                                  f"scaling the driver reports counted): canceled, suction off")
+        result = handle.result()
+        if result.status != "succeeded":
+            self.suction(False)
+            verb = "rejected" if result.status == "rejected" else "ended"
+            raise DriverGoalError(f"the driver's controller {verb} {label}: {result.describe()}; suction off, "
+                                  "the solve stops", result)
+
+    def _cancel(self, handle: GoalHandle) -> None:
+        if not handle.done():
+            handle.cancel()
+            self.sleep(1.0, handle.done)
+
+    def suction(self, on: bool) -> None:
+        if not self.tr.set_io(FUN_SET_DIGITAL_OUT, self.wiring.output, 1.0 if on else 0.0):
+            raise DriverError(f"set_io(fun={FUN_SET_DIGITAL_OUT}, pin={self.wiring.output}, state="
+                              f"{1 if on else 0}) answered success = false on {self.tr.where}: is the pin right "
+                              "(calibration io.suction_output) and the robot program running?")
+
+    def move_to(self, q1: FloatArray, speed: float, what: str) -> float:
+        """A slow goal from where the arm is to ``q1``; returns its duration [s]."""
+        goal = move_goal(self.q(), q1, self.plan.station, speed)
+        self.run_goal(goal, what)
+        return goal.points[-1].time_from_start_s
+
+    def at_rest(self) -> None:
+        """Wait until the arm stops (the controller's stop ramp after a cancel)."""
+        history: list[FloatArray] = []
+
+        def still() -> bool:
+            history.append(self.q())
+            return len(history) > 10 and float(np.max(np.abs(history[-1] - history[-10]))) < 1e-4
+
+        self.sleep(self.cfg.rest_timeout_s, still)
+
+    # ------------------------------------------------------------------------------------------ steps
+    def start(self) -> float:
+        """Bring the arm to where the plan starts, or refuse (see the module docstring); returns the wall time."""
+        q0, q = self.plan.trajectory.q[0], self.q()
+        off = np.abs(q - q0)
+        far = float(off.max())
+        if far <= self.cfg.start_tolerance_rad:
+            return 0.0
+        joint = CONTROLLER_JOINTS[int(off.argmax())]
+        where = f"the arm is {far:.3f} rad from where the plan starts ({joint})"
+        if self.cfg.far_start == "refuse":
+            raise DriverError(f"{where}: expected within {self.cfg.start_tolerance_rad:g} rad; bring it there first "
+                              "(the station's home)")
+        t0 = self.tr.now()
+        goal = move_goal(q, q0, self.plan.station, self.cfg.approach_speed)
+        self.say(f"{where}: moving there first at {100 * self.cfg.approach_speed:g} % speed "
+                 f"({goal.points[-1].time_from_start_s:.1f} s)")
+        self.run_goal(goal, "to the plan's start")
+        return self.tr.now() - t0
+
+    def dwell(self, s: Stretch) -> None:
+        cfg = self.cfg
+        t0 = self.tr.now()
+        if s.kind == "grasp":
+            self.suction(True)
+            if not self.sleep(cfg.grasp_timeout_s, self.held):
+                raise _HaltError("missing")
+            self.sleep(s.duration_s - (self.tr.now() - t0))
+        else:
+            self.suction(False)
+            self.sleep(cfg.release_timeout_s, lambda: not self.held())
+            self.sleep(s.duration_s - (self.tr.now() - t0))
+
+    def halt(self, kind: str, move: int) -> SuctionFaultError:
+        """Suction off, the arm at rest, then home; the error to raise."""
+        feedback = self.feedback_text()
+        self.suction(False)
+        self.at_rest()
+        self.move_to(self.plan.station.q_home_array, self.cfg.home_speed, "home after the halt")
+        moves = self.plan.moves
+        mv = moves[move]
+        where = (f"at tower {mv.from_tower + 1} height {mv.from_height + 1}" if kind == "missing"
+                 else f"while carrying it from tower {mv.from_tower + 1} to tower {mv.to_tower + 1}")
+        return SuctionFaultError(
+            f"suction fault in move {move + 1}/{len(moves)}: {block_colour(mv.block)} block {mv.block + 1} "
+            f"{'is missing' if kind == 'missing' else 'was dropped'} {where} ({feedback}); halted, suction off, "
+            "arm returned home")
+
+
+def run_driver_solve(transport: DriverTransport, plan: Plan, wiring: SuctionWiring,
+                     config: DriverSolveConfig | None = None,
+                     log: Callable[[str], None] | None = None) -> DriverSolveResult:
+    """Execute ``plan`` through ``transport`` (connected) with the lab's suction checks (see the module docstring).
+
+    Raises:
+        SuctionFaultError: a block was missing or dropped; the arm has halted (suction off, home).
+        DriverGoalError: the controller rejected or aborted a goal (suction off).
+        DriverError: the arm is far from the plan's start (``far_start="refuse"``), a goal timed out, the joint
+            states stopped, or ``set_io`` failed.
+    """
+    cfg = config if config is not None else DriverSolveConfig()
+    run = _Solve(transport, plan, wiring, cfg, log if log is not None else (lambda _s: None))
+    stretches = plan_stretches(plan)
+    run.n_goals = sum(s.kind == "motion" for s in stretches)
+    t0 = transport.now()
+    approach = run.start()
+    t_plan = transport.now()
+    move = -1
+    try:
+        for s in stretches:
+            move = s.move if s.move >= 0 else move
+            if s.goal is None:
+                run.dwell(s)
+                continue
+            what = "home" if s.move < 0 and move >= 0 else ("carry" if s.carrying else "approach") + \
+                (f" of move {s.move + 1}" if s.move >= 0 else "")
+            run.run_goal(s.goal, what, s.carrying)
+    except _HaltError as halt:
+        raise run.halt(halt.kind, move) from None
+    now = transport.now()
+    return DriverSolveResult(plan.moves, run.goals, now - t0, approach, now - t_plan, plan.duration_s)
