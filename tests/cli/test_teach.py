@@ -102,3 +102,36 @@ def test_finish_with_a_tower_missing_says_which(tmp_path: Path, capsys: pytest.C
     assert main(["teach", "--via", "ros2", "--base", "lab_real", "-o", str(out), "--finish"]) == 2
     assert "tower(s) 2, 3 have none" in one_line(capsys.readouterr().err)
     assert out.read_text() == TAUGHT and not (tmp_path / "t_station.yaml").exists()
+
+
+def test_finish_refuses_a_wrong_point_that_is_its_tower_s_only_contact(tmp_path: Path,
+                                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    base = load_station("lab_real")
+    q = generate_table(base).q
+    f = open_taught(tmp_path / "t.yaml", base, "lab_real")
+    for (t, h), qi in zip(((0, 2), (1, 0), (2, 0)), (q[0, 2, 0], base.q_home_array, q[2, 0, 0]), strict=True):
+        f = f.with_point(t, h, tuple(float(v) for v in qi))[0]  # tower 2 recorded with the arm at home
+    f.save()
+    before = f.path.read_text()
+    assert main(["teach", "--via", "ros", "--base", "lab_real", "-o", str(f.path), "--finish"]) == 2
+    line = one_line(capsys.readouterr().err)
+    assert "nothing written: tower 2 height 1 [points[1]] is " in line and "the arm was at home" in line
+    assert f.path.read_text() == before and not (tmp_path / "t_station.yaml").exists()
+
+
+def test_finish_accepts_a_tower_on_the_student_s_word(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    base = load_station("lab_real")
+    o = list(base.tower_origins)
+    o[2] = (o[2][0], o[2][1] + 0.025, o[2][2])  # tower 3 stands 25 mm further along the row
+    q = generate_table(base.with_grid(o, base.height_step, base.tool_yaw)).q
+    f = open_taught(tmp_path / "t.yaml", base, "lab_real")
+    for t, h in ((0, 2), (1, 0), (2, 0)):
+        f = f.with_point(t, h, tuple(float(v) for v in q[t, h, 0]))[0]
+    f.save()
+    argv = ["teach", "--via", "ros", "--base", "lab_real", "-o", str(f.path), "--finish"]
+    assert main(argv) == 2
+    assert "run again with --accept 3,1" in one_line(capsys.readouterr().err)
+    assert main([*argv, "--accept", "3,1"]) == 0
+    out = capsys.readouterr().out
+    assert "tower 3 placed by tower 3 height 1 [points[2]] on your word (--accept 3,1): " in out
+    np.testing.assert_allclose(load_station(tmp_path / "t_station.yaml").tower_origins, o, atol=1e-6)

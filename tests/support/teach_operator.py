@@ -130,7 +130,8 @@ OFF_MM = (9.0, 0.0, 12.0)
 def practice_session(child: Any, base: Station, hidden: Station) -> dict[str, Any]:
     """The whole practice session on a running station, through teach's pseudo-terminal ``child``: three contacts
     (the third first 15 mm off: named as a suspect, undone, taught again), an Enter while a jog step runs (refused),
-    then ``f``. Returns what the operator saw and did."""
+    a fourth pose recorded in the wrong slot (tower 3's, as tower 1 height 1: named at once, undone), then ``f``.
+    Returns what the operator saw and did."""
     import pexpect
 
     op = Operator(child, base, hidden)
@@ -152,6 +153,10 @@ def practice_session(child: Any, base: Station, hidden: Station) -> dict[str, An
     op.expect("undone")
     seen["at_mm"].append(op.move_to(2, 0, ERRORS_MM[2]).tolist())
     seen["after"] = op.record("tower 3 height 1")
+    # Teach names tower 1 height 1 next; Enter with the arm still on tower 3 records a pose in the wrong slot.
+    seen["wrong_slot"] = op.record("tower 1 height 1")
+    child.send("u")
+    op.expect("undone")
     child.send("f")
     child.expect(pexpect.EOF, timeout=180)
     child.close()

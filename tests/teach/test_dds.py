@@ -43,7 +43,8 @@ exit $CODE
     assert result.returncode == 0, result.stdout + result.stderr + transcript + (tmp_path / "st.err").read_text()
     seen = json.loads((tmp_path / "operator.json").read_text())
     assert seen["exit"] == 0 and seen["moving_refused"]
-    assert "tower 3 height 1 is 1" in seen["suspect"] and "re-record it?" in seen["suspect"]
+    assert "tower 3 height 1 is 1" in seen["suspect"] and seen["suspect"].count("re-record it") == 1
+    assert "tower 1 height 1 is " in seen["wrong_slot"] and "SUSPECT" in seen["wrong_slot"]
     assert "every point agrees with the others" in seen["after"]
     assert "ur3hanoi's simulated station, no pendant" in transcript and "ROS_DOMAIN_ID 0 (loopback)" in transcript
     assert "next, slowly" in transcript and "ur3hanoi ros2-solve --table" in transcript

@@ -4,7 +4,8 @@ wall clock), driven through its pseudo-terminal by a scripted operator (tests/su
 The station runs a hidden calibration (``lab_real``'s grid turned 2 deg and moved 5, -4, 1 mm): the operator jogs
 with teach's own keys to three contacts with about 1 mm of deliberate error, the fitted grid matches the hidden one
 as well as the poses do, and ``ros-solve`` with the written table solves 3 blocks on that station. Also: Enter while
-the arm moves records nothing, a pose 15 mm off is named at once, Ctrl-C after two records leaves a valid file that
+the arm moves records nothing, a pose 15 mm off is named at once, so is a pose recorded in the wrong slot (tower 3's
+as tower 1 height 1), Ctrl-C after two records leaves a valid file that
 the next session continues, a closed terminal loses nothing, a station killed mid-session ends teach with one line,
 and a driver that is missing or publishes 5 joints or NaN gets one line.
 """
@@ -76,8 +77,12 @@ def test_a_practice_session_teaches_the_hidden_station_and_ros_solve_solves_on_i
     assert seen["exit"] == 0, transcript
     assert seen["moving_refused"]
     assert "tower 3 height 1 is 1" in seen["suspect"] and "mm from where the other points put it" in seen["suspect"]
-    assert "re-record it?" in seen["suspect"] and "SUSPECT" in seen["suspect"]
+    assert seen["suspect"].count("re-record it") == 1 and "SUSPECT" in seen["suspect"]
     assert "every point agrees with the others" in seen["after"]
+    # A pose recorded in the wrong slot is named at once, first, with the slot it belongs to.
+    named = [line for line in seen["wrong_slot"].splitlines() if line.startswith("tower ")]
+    assert named and named[0].startswith("tower 1 height 1 is ") and "tower 3 height 1" in named[0], seen["wrong_slot"]
+    assert "SUSPECT" in seen["wrong_slot"] and "next: tower 1 height 1: suspect: record it again" in seen["wrong_slot"]
     assert len(load_taught(folder / "taught.yaml").points) == 3
     assert "wrote real_pos (3 towers x 3 heights x 2) to lab2_data.yaml" in transcript
     assert "next, slowly" in transcript and "ur3hanoi ros-solve --table lab2_data.yaml --key real_pos" in transcript

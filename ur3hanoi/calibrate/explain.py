@@ -26,6 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from ur3hanoi.arrays import FloatArray
+from ur3hanoi.robot.ik import wrap_angle
 from ur3hanoi.robot.model import Ur3Model
 from ur3hanoi.station.grid import R_world_tcp_down
 from ur3hanoi.tables import Slot
@@ -35,6 +36,8 @@ JOINT_LABELS: tuple[str, ...] = ("base", "shoulder", "elbow", "wrist 1", "wrist 
 
 MIN_TYPO_DEG = 0.5
 """[deg] a single-joint change smaller than this is noise, not a typo."""
+MIN_SIGN_DEG = 10.0
+"""[deg] a joint value at least this far from 0 and 180 deg, negated, is called a sign typo."""
 
 
 def angle_text(rad: float) -> str:
@@ -61,10 +64,22 @@ class JointTypo:
     residual_deg: float
     explains: bool
 
+    @property
+    def sign(self) -> bool:
+        """True when the value that fits is the recorded one negated (a minus sign typed or lost), whole turns
+        aside, within 1 deg, and negating it changes it by at least twice :data:`MIN_SIGN_DEG` (a value near 0 or
+        180 deg negated is as much an ordinary typo)."""
+        change = abs(float(wrap_angle(2.0 * self.recorded)))
+        return change >= math.radians(2.0 * MIN_SIGN_DEG) and abs(float(wrap_angle(
+            self.recorded + self.predicted))) < math.radians(1.0)
+
     def describe(self) -> str:
-        """``"a typo in joint 2 (shoulder): recorded -45.0 deg (-0.785 rad), the grid predicts -55.0 deg ..."``."""
-        return (f"a typo in joint {self.joint + 1} ({JOINT_LABELS[self.joint]}): recorded {angle_text(self.recorded)}, "
-                f"the grid predicts {angle_text(self.predicted)}")
+        """``"a typo in joint 2 (shoulder): recorded -45.0 deg (-0.785 rad), the grid predicts -55.0 deg ..."``
+        (``"a sign typo in joint 2 ..."`` when :attr:`sign`)."""
+        kind = "a sign typo" if self.sign else "a typo"
+        predicted = -self.recorded if self.sign else self.predicted
+        return (f"{kind} in joint {self.joint + 1} ({JOINT_LABELS[self.joint]}): recorded {angle_text(self.recorded)}, "
+                f"the grid predicts {angle_text(predicted)}")
 
 
 def _errors(robot: Ur3Model, T_wb: pin.SE3, q: FloatArray, target: pin.SE3) -> tuple[float, float]:
@@ -326,6 +341,7 @@ def diagnose_contacts(robot: Ur3Model, T_world_base: pin.SE3, slots: Sequence[Sl
 
 __all__ = [
     "JOINT_LABELS",
+    "MIN_SIGN_DEG",
     "MIN_TYPO_DEG",
     "TYPO_SHARE",
     "JointTypo",

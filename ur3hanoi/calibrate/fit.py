@@ -1,8 +1,18 @@
 """Fit a station's grid to taught poses, robustly, and say which poses are suspect and why.
 
 :func:`fit_station` measures every pose by FK with the base calibration's robot base and tool
-(:mod:`~ur3hanoi.calibrate.grid_fit`), fits the grid with sequential leave-one-out deletion
-(:mod:`~ur3hanoi.calibrate.robust`), and explains each suspect (:mod:`~ur3hanoi.calibrate.explain`).
+(:mod:`~ur3hanoi.calibrate.grid_fit`), decides which point (if any) is grossly wrong on all the evidence
+(:mod:`~ur3hanoi.calibrate.consensus`), fits the grid with sequential leave-one-out deletion
+(:mod:`~ur3hanoi.calibrate.robust`), and explains each suspect (:mod:`~ur3hanoi.calibrate.verdict` for the point
+the consensus named, :mod:`~ur3hanoi.calibrate.explain` for the others).
+
+The point the consensus names is left out of the fit (when the robust fit would have kept it, the fit is made
+again without it). When it is its tower's only contact nothing can be written without it, and when the points
+cannot tell which of several is wrong nothing can be written either: the fit is returned with
+:attr:`CalibrationFit.problem` saying which and what to do. A tower taught once stands where the base's layout,
+moved and turned onto the other towers, puts it (within the always-flagged 8 mm) unless the student accepts its
+point (``accept``). When no single point explains a disagreement, the robust fit's choice is judged the same way
+and refused if it still disagrees.
 
 Points that cannot take part in the fit are suspects from the start, never a reason to stop: a slot outside the
 base's grid, joint angles outside its limits, a tool tilted more than :data:`MAX_TILT_DEG` from pointing down. An
@@ -21,12 +31,14 @@ it.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
+from ur3hanoi.calibrate.consensus import Consensus
+from ur3hanoi.calibrate.evidence import judge
 from ur3hanoi.calibrate.explain import diagnose
 from ur3hanoi.calibrate.grid_fit import (
     BoolArray,
@@ -34,71 +46,19 @@ from ur3hanoi.calibrate.grid_fit import (
     GridSolution,
     Measured,
     choose_model,
-    measure,
 )
+from ur3hanoi.calibrate.limits import ABOVE_FLAG_LINE_MM, CONTACT_FLAG_MM, MAX_APPROACH_M
+from ur3hanoi.calibrate.prepare import MAX_TILT_DEG, Prepared, fail, prepare, underdetermined
 from ur3hanoi.calibrate.result import CalibrationFit, Suspect
 from ur3hanoi.calibrate.robust import RobustFit, robust_fit
 from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
-from ur3hanoi.errors import CalibrationError, TaughtPointsError, printable
+from ur3hanoi.calibrate.verdict import named_text, refusal, slot_text, unexplained, where_text
+from ur3hanoi.errors import CalibrationError, printable
 from ur3hanoi.robot.ik import wrap_angle
 from ur3hanoi.robot.model import load_ur3
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.station.grid import ABOVE, ON
 from ur3hanoi.tables import Slot
-
-MAX_TILT_DEG = 10.0  # [deg] a taught pose's tool must point down within this to be used (tables use exactly down)
-MAX_APPROACH_M = 0.5  # [m] largest approach height a fit may give
-
-
-def _fail(source: str, msg: str) -> TaughtPointsError:
-    return TaughtPointsError(f"{printable(source)}: {msg}", source=source)
-
-
-# --------------------------------------------------------------------------------------------------- checks
-
-
-def _off_grid(base: Station, p: TaughtPoint) -> bool:
-    return not (0 <= p.tower < base.n_towers and 0 <= p.height < base.n_heights)
-
-
-def _hard_problems(base: Station, points: Sequence[TaughtPoint], m: Measured) -> list[str]:
-    """Per point, why it cannot take part in the fit ("" if it can)."""
-    out = []
-    for i, p in enumerate(points):
-        if not 0 <= p.tower < base.n_towers:
-            out.append(f"tower {p.tower + 1} is outside the base calibration's grid (towers 1..{base.n_towers} in "
-                       f"{printable(base.source)})")
-        elif not 0 <= p.height < base.n_heights:
-            out.append(f"height {p.height + 1} is outside the base calibration's grid (heights 1..{base.n_heights} "
-                       f"in {printable(base.source)})")
-        elif not base.limits.within_position(np.asarray(p.q, dtype=float)):
-            out.append(f"joint angles {np.round(np.degrees(p.q), 3).tolist()} deg are outside the joint limits of "
-                       f"{printable(base.source)}")
-        elif m.tilt_deg[i] > MAX_TILT_DEG:
-            out.append(f"the tool is tilted {m.tilt_deg[i]:.2f} deg from pointing down (more than "
-                       f"{MAX_TILT_DEG:g} deg: left out of the fit)")
-        else:
-            out.append("")
-    return out
-
-
-def _underdetermined(where: str, base: Station, points: Sequence[TaughtPoint], candidates: BoolArray,
-                     hard: Sequence[str]) -> TaughtPointsError:
-    """The "too little left to fit" error: what the grid needs, what is missing, what was left out."""
-    usable_on = {p.tower for i, p in enumerate(points) if candidates[i] and p.k == ON}
-    lacking = [t + 1 for t in range(base.n_towers) if t not in usable_on]
-    need = ("too little left to fit the grid: it needs a usable contact ('on') pose on every tower "
-            f"({base.n_towers} towers), and above poses count only on towers that also have one")
-    if lacking:
-        need += f"; tower(s) {', '.join(map(str, lacking))} have none"
-    left_out = [f"{p.label}: {hard[i]}" for i, p in enumerate(points) if hard[i]]
-    if left_out:
-        more = f" and {len(left_out) - 2} more" if len(left_out) > 2 else ""
-        need += f" (left out: {'; '.join(left_out[:2])}{more})"
-    if sum("tilted" in h for h in hard) > len(points) // 2:
-        need += f"; most poses are tilted: is the tool offset of {printable(base.source)} right?"
-    return _fail(where, need)
-
 
 # ------------------------------------------------------------------------------------------------- fitting
 
@@ -156,6 +116,8 @@ class _Context:
     shared: BoolArray
     hard: tuple[str, ...]
     grid_points: dict[Slot, FloatArray]
+    named: dict[int, str]
+    heads: dict[int, str]
 
 
 def _reasons(ctx: _Context, suspects: Sequence[int]) -> dict[int, str]:
@@ -178,7 +140,9 @@ def _reasons(ctx: _Context, suspects: Sequence[int]) -> dict[int, str]:
             continue
         parts = []
         dev = float(np.linalg.norm(m.p_world[i] - ctx.fitted[i])) * 1e3
-        if ctx.shared[i]:
+        if i in ctx.heads:  # a named point the fit had to keep: where the others put it, not this fit
+            parts.append(ctx.heads[i])
+        elif ctx.shared[i]:
             heights = ", ".join(str(h + 1) for h in p.shared)
             parts.append(f"the above pose shared by heights {heights} of tower {p.tower + 1} is {dev:.1f} mm from "
                          "standing over this contact point at least one block above it")
@@ -187,6 +151,9 @@ def _reasons(ctx: _Context, suspects: Sequence[int]) -> dict[int, str]:
                          "this one)")
         else:
             parts.append(f"{dev:.1f} mm from the grid fitted to {_basis(pts, ctx.fit.used, i)}")
+        if i in ctx.named:  # the consensus said what is wrong with it
+            out[i] = "; ".join([*parts, ctx.named[i]])
+            continue
         if ctx.fit.rot_deg[i] > th.deg and m.tilt_deg[i] <= MAX_TILT_DEG:
             yaw_dev = math.degrees(float(wrap_angle(m.heading[i] - ctx.fit.yaw)))
             parts.append(f"the tool is turned {ctx.fit.rot_deg[i]:.1f} deg from the grid pose (tilt "
@@ -200,9 +167,13 @@ def _reasons(ctx: _Context, suspects: Sequence[int]) -> dict[int, str]:
 
 
 def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], name: str | None = None,
-                source: str = "<memory>", tol_mm: float | None = None, tol_deg: float | None = None
-                ) -> CalibrationFit:
+                source: str = "<memory>", tol_mm: float | None = None, tol_deg: float | None = None,
+                accept: Collection[tuple[int, int]] = ()) -> CalibrationFit:
     """Fit the grid of ``base`` (tower origins, height step, approach, tool yaw) to taught poses, robustly.
+
+    Which point is grossly wrong is decided first, on all the evidence (:mod:`ur3hanoi.calibrate.consensus`): the
+    one named is left out (the robust fit never uses it), or, when it is its tower's only contact or the points
+    cannot tell which of several is wrong, the fit is refused (:attr:`CalibrationFit.problem`).
 
     Args:
         base: calibration providing everything not fitted (robot base, tool offset, blocks, home, counts, layout).
@@ -211,6 +182,8 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
         source: recorded as the new station's ``source`` (the output file's path).
         tol_mm, tol_deg: fixed suspect thresholds [mm], [deg] instead of the ones derived from the data (see
             :mod:`ur3hanoi.calibrate.robust`).
+        accept: ``(tower, height)`` slots (0-based) whose contact poses the student vouches for: never left out,
+            and their towers placed where they say even far from the base's layout.
 
     Raises:
         TaughtPointsError: no points, a table whose shape is not the base's grid, or too little left to fit.
@@ -220,34 +193,73 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
     else:
         points, where, missing, shape = tuple(taught), "<memory>", (), None
     if not points:
-        raise _fail(where, "no taught points")
+        raise fail(where, "no taught points")
     if shape is not None and shape != (base.n_towers, base.n_heights):
-        raise _fail(where, f"the table has {shape[0]} towers x {shape[1]} heights, the base calibration "
+        raise fail(where, f"the table has {shape[0]} towers x {shape[1]} heights, the base calibration "
                            f"{printable(base.source)} {base.n_towers} x {base.n_heights}: use a base with the table's "
                            "grid")
 
-    m = measure(base, [p.q for p in points])
-    hard = tuple(_hard_problems(base, points, m))
-    shared = np.array([bool(p.shared) and not hard[i] for i, p in enumerate(points)])
-    candidates = np.array([not hard[i] and not shared[i] for i in range(len(points))])
+    prep = prepare(base, points, accept)
     slots = [(p.tower, p.height, p.k) for p in points]
+    candidates = prep.candidates.copy()
     model = choose_model(base, [s for s, c in zip(slots, candidates, strict=True) if c])
     if model is None:
-        raise _underdetermined(where, base, points, candidates, hard)
-    # Points outside the grid take no part; they get placeholder slots (never used) so arrays stay aligned.
-    off_grid = np.array([_off_grid(base, p) for p in points])
-    safe_slots = [(0, 0, ON) if off_grid[i] else s for i, s in enumerate(slots)]
-    fit = robust_fit(base, model, safe_slots, m, candidates, tol_mm, tol_deg)
-    station, problem = _station(base, model, fit.solution, fit.yaw, source)
+        raise underdetermined(where, base, points, candidates, prep.hard)
+    fit = robust_fit(base, model, prep.safe_slots, prep.m, candidates, tol_mm, tol_deg)
+    c = prep.consensus
+    named = {i: named_text(prep.evidence, c, i, points) for i in c.wrong}
+    refused = c.kind == "undecided" or (c.kind == "named" and c.alone)
+    problem = refusal(prep.evidence, c, points) if refused else ""
+    heads = {i: where_text(prep.evidence, c, i) for i in c.wrong} if refused else {}
+    agreeing = candidates & ~np.isin(np.arange(len(points)), c.wrong if c.kind == "named" else ())
+    if c.kind == "named" and not c.alone and fit.used[c.wrong[0]]:
+        candidates = agreeing  # left out from the start: it never drags the fit
+        model = choose_model(base, [s for s, k in zip(slots, candidates, strict=True) if k])
+        assert model is not None  # its tower has another contact
+        fit = robust_fit(base, model, prep.safe_slots, prep.m, candidates, tol_mm, tol_deg)
+    if c.kind in ("agree", "named") and not refused and _bends(fit, prep, agreeing):
+        # The finer pruning left out points that agree with the rest, and the grid moved more than the
+        # always-flagged distance from them: they agree, so they all stay.
+        candidates = agreeing
+        model = choose_model(base, [s for s, k in zip(slots, candidates, strict=True) if k])
+        assert model is not None
+        fit = robust_fit(base, model, prep.safe_slots, prep.m, candidates, tol_mm, tol_deg, prune=False)
+    station, invalid = _station(base, model, fit.solution, fit.yaw, source)
     if name is not None:
         station = replace(station, name=name)
-    ctx = _judged(base, station, points, m, fit, safe_slots, off_grid, shared, hard)
-    return _calibration_fit(ctx, station, model, candidates, missing, problem)
+    ctx = _judged(base, station, points, prep.m, fit, prep.safe_slots, prep.off_grid, prep.shared, prep.hard, named,
+                  heads)
+    return _with_consensus(_calibration_fit(ctx, station, model, candidates, missing, problem or invalid), prep, c)
+
+
+def _with_consensus(fit: CalibrationFit, prep: Prepared, c: Consensus) -> CalibrationFit:
+    """The fit with what the consensus said: each point's distance from where the others put it, the points taken
+    on the student's word, and, when no single point explains a disagreement the robust fit left, why."""
+    accepted: tuple[tuple[int, float], ...] = ()
+    if prep.evidence.accepted.any():  # how far the layout would have put their towers
+        kept = prep.candidates & ~np.isin(np.arange(len(fit.points)), c.wrong)
+        word = replace(prep.evidence, accepted=np.zeros(len(fit.points), dtype=bool))
+        layout = {ch.index: ch.value for ch in judge(word, kept).checks if ch.what == "layout"}
+        accepted = tuple((int(i), float(layout.get(fit.points[i].tower, math.nan)))
+                         for i in np.flatnonzero(prep.evidence.accepted))
+    out = replace(fit, consensus=c.kind, named=c.wrong, off_mm=c.chosen.off_mm, judged_by=c.chosen.by,
+                  accepted=accepted)
+    if c.kind == "unexplained" and fit.sound:
+        # The robust fit's choice, judged again; a tower it kept one of several contacts of stands where they agree
+        # (swapped heights, say), so only a tower taught once is judged by the base's layout.
+        left = judge(prep.evidence, np.array(fit.used) & prep.candidates)
+        taught_once = {p.tower for i, p in enumerate(fit.points) if prep.candidates[i] and p.k == ON and sum(
+            prep.candidates[k] and q.k == ON and q.tower == p.tower for k, q in enumerate(fit.points)) == 1}
+        left = replace(left, checks=tuple(ch for ch in left.checks if ch.what != "layout" or ch.index in taught_once))
+        problem = unexplained(prep.evidence, left, fit.points)
+        if problem:
+            out = replace(out, problem=problem, warnings=(*fit.warnings, f"the fit is not sound: {problem}"))
+    return out
 
 
 def _judged(base: Station, station: Station, points: Sequence[TaughtPoint], m: Measured, fit: RobustFit,
             safe_slots: Sequence[tuple[int, int, int]], off_grid: BoolArray, shared: BoolArray,
-            hard: tuple[str, ...]) -> _Context:
+            hard: tuple[str, ...], named: dict[int, str], heads: dict[int, str]) -> _Context:
     """Every point against the fitted grid: where the grid puts it (shared "above" poses and off-grid points by
     the final station), its deviation, and the context the explanations need."""
     fitted = fit.solution.points(safe_slots)
@@ -257,7 +269,7 @@ def _judged(base: Station, station: Station, points: Sequence[TaughtPoint], m: M
     grid_points = {(t, h, k): fit.solution.point((t, h, k)) for t in range(base.n_towers)
                    for h in range(base.n_heights) for k in (ON, ABOVE)}
     return _Context(base=base, points=tuple(points), m=m, fit=fit, fitted=fitted, shared=shared, hard=hard,
-                    grid_points=grid_points)
+                    grid_points=grid_points, named=named, heads=heads)
 
 
 def _calibration_fit(ctx: _Context, station: Station, model: GridModel, candidates: BoolArray,
@@ -268,8 +280,12 @@ def _calibration_fit(ctx: _Context, station: Station, model: GridModel, candidat
     # Shared poses and points left out are judged by their distance from the final grid.
     dev_mm = np.where(fit.used & fit.removable, fit.deviation_mm, residuals)
     severity = np.maximum(dev_mm / fit.thresholds.mm, fit.rot_deg / fit.thresholds.deg)
-    is_suspect = (~fit.used & candidates) | (severity > 1.0) | np.array([bool(h) for h in ctx.hard])
+    named = np.isin(np.arange(len(points)), list(ctx.named))
+    is_suspect = named | np.array([bool(h) for h in ctx.hard])
+    if not ctx.heads:  # when the named points had to stay in the fit, it judges the others wrongly: not shown
+        is_suspect |= (~fit.used & candidates) | (severity > 1.0)
     order = sorted(np.flatnonzero(is_suspect), key=lambda i: -np.nan_to_num(severity[i], nan=np.inf))
+    order = [i for i in ctx.named if i in order] + [i for i in order if i not in ctx.named]  # the named first
     reasons = _reasons(ctx, [int(i) for i in order])
     suspects = tuple(
         Suspect(index=int(i), tower=points[i].tower, height=points[i].height, k=points[i].k, field=points[i].where,
@@ -278,7 +294,7 @@ def _calibration_fit(ctx: _Context, station: Station, model: GridModel, candidat
         for i in order)
 
     if not problem:
-        problem = _soundness(fit, candidates, dev_mm)
+        problem = _soundness(fit, candidates, dev_mm, points)
     warnings = [f"{s.label} [{s.field}]: {s.reason}" for s in suspects]
     if problem:
         warnings.append(f"the fit is not sound: {problem}")
@@ -293,7 +309,18 @@ def _calibration_fit(ctx: _Context, station: Station, model: GridModel, candidat
     )
 
 
-def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray) -> str:
+def _bends(fit: RobustFit, prep: Prepared, candidates: BoolArray) -> bool:
+    """Whether the fit puts a candidate it left out farther from its slot than the always-flagged distance (an
+    above pose: off its tower's line)."""
+    d = prep.m.p_world - fit.solution.points(prep.safe_slots)
+    for i in np.flatnonzero(candidates & ~fit.used):
+        on = prep.safe_slots[i][2] == ON
+        if float(np.linalg.norm(d[i] if on else d[i, :2])) * 1e3 > (CONTACT_FLAG_MM if on else ABOVE_FLAG_LINE_MM):
+            return True
+    return False
+
+
+def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray, points: Sequence[TaughtPoint]) -> str:
     """Why the remaining fit cannot be trusted ("" if it can)."""
     n = int(candidates.sum())
     left_out = int((candidates & ~fit.used).sum())
@@ -301,10 +328,15 @@ def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray) -> str
     if left_out >= max(1, (n - 1) // 2) and over.any():
         return (f"{left_out} of {n} points left out and more still disagree with the grid: check the base "
                 "calibration's robot base and tool, and the tower/height labels")
-    if over.any():
-        return (f"{int(over.sum())} point(s) the fit cannot do without are more than {fit.thresholds.mm:.1f} mm off "
-                "the grid: re-record them or add points")
+    stuck = over & ~fit.removable  # the others do not determine the grid without them (pruning drops the others)
+    if stuck.any():
+        worst = sorted(np.flatnonzero(stuck), key=lambda i: -dev_mm[i])
+        named = [f"{slot_text(points[i])} ({dev_mm[i]:.1f} mm)" for i in worst[:3]]
+        more = f" and {len(worst) - 3} more" if len(worst) > 3 else ""
+        return (f"{', '.join(named)}{more}, which the fit cannot do without, {'is' if len(worst) == 1 else 'are'} "
+                f"more than {fit.thresholds.mm:.1f} mm off the grid: re-record {'it' if len(worst) == 1 else 'them'} "
+                "or add points")
     return ""
 
 
-__all__ = ["MAX_TILT_DEG", "fit_station"]
+__all__ = ["fit_station"]

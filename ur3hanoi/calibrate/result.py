@@ -7,7 +7,7 @@ with its reference, whether a fit or a calibration judged it.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -93,6 +93,14 @@ class CalibrationFit:
         missing: the slots a table left empty ``(tower, height, k)`` (0-based).
         problem: why the fit is not sound ("" when it is).
         warnings: one line per suspect (``"<label>: <reason>"``) and the problem, if any.
+        consensus: what the choice of the wrong point found (:class:`ur3hanoi.calibrate.consensus.Consensus`'s
+            ``kind``: ``agree``, ``named``, ``undecided``, ``unexplained``).
+        named: the points it named as wrong (indices, best first).
+        off_mm: (N,) each point's distance [mm] from where the other points put it (NaN: nothing could say).
+        judged_by: per point, what placed it: ``points``, ``layout`` (the base's layout, for a tower taught once)
+            or "".
+        accepted: ``(index, mm)`` of the points taken on the student's word: how far [mm] from where the base's
+            layout, moved onto the other towers, puts their tower (NaN when nothing could say).
     """
 
     station: Station
@@ -112,6 +120,11 @@ class CalibrationFit:
     missing: tuple[Slot, ...]
     problem: str
     warnings: tuple[str, ...]
+    consensus: str = "agree"
+    named: tuple[int, ...] = ()
+    off_mm: FloatArray = field(default_factory=lambda: np.zeros(0))
+    judged_by: tuple[str, ...] = ()
+    accepted: tuple[tuple[int, float], ...] = ()
 
     @property
     def sound(self) -> bool:

@@ -212,19 +212,22 @@ class _Lts:
         candidates never do). The rank is followed with an orthonormal basis of the rows taken (Gram-Schmidt): the
         design holds 0, 1 and small integers, so a new row either adds a unit-size direction or none."""
         n_unknowns = self.model.n_unknowns
-        basis = np.zeros((0, n_unknowns))
+        basis = np.zeros((n_unknowns, n_unknowns))
+        rank = 0
         chosen: list[int] = []
         for i in order:
             grew = False
             for row in self.A[3 * int(i):3 * int(i) + 3]:
-                rest = row - (basis @ row) @ basis
-                norm = float(np.linalg.norm(rest))
+                taken = basis[:rank]
+                rest = row - (taken @ row) @ taken
+                norm = math.sqrt(float(rest @ rest))
                 if norm > 1e-9:
-                    basis = np.vstack([basis, rest / norm])
+                    basis[rank] = rest / norm
+                    rank += 1
                     grew = True
             if grew:
                 chosen.append(int(i))
-                if len(basis) == n_unknowns:
+                if rank == n_unknowns:
                     return np.array(chosen)
         return None
 
@@ -257,6 +260,8 @@ class _Lts:
         """The :data:`N_STARTS` best distinct trimmed fits' ``h`` closest candidates (indices), best first."""
         n = len(cand)
         h = min(n, (n + math.ceil(self.model.n_unknowns / 3) + 1) // 2)
+        if h == n:  # no point to trim: every subset's trimmed fit is the fit of them all
+            return [cand]
         rng = np.random.default_rng(_SEED)
         found: dict[tuple[int, ...], tuple[float, GridSolution]] = {}
         tried: set[tuple[int, ...]] = set()
@@ -284,16 +289,21 @@ class _Lts:
 
 def robust_fit(base: Station, model: GridModel, slots: Sequence[Slot], m: Measured, candidates: BoolArray,
                tol_mm: float | None = None, tol_deg: float | None = None, angle_deg: FloatArray | None = None,
-               mm_range: tuple[float, float] | None = None) -> RobustFit:
+               mm_range: tuple[float, float] | None = None, prune: bool = True) -> RobustFit:
     """Fit ``model`` to the ``candidates`` among the points measured at ``slots``, leaving out gross errors
     (see the module docstring).
 
     ``candidates`` must determine ``model``. ``tol_mm`` / ``tol_deg`` replace the derived thresholds.
     ``angle_deg`` (N,) replaces the orientation error judged with each point (default: its angle from the grid
     pose, heading included); zeros judge positions only (the audit checks the suction axis on its own).
-    ``mm_range`` (floor, ceiling) [mm] bounds the derived position threshold instead of the floor alone.
+    ``mm_range`` (floor, ceiling) [mm] bounds the derived position threshold instead of the floor alone. With
+    ``prune`` False every candidate stays in the fit (the points are known to agree: they are only judged).
     """
     cand = np.flatnonzero(candidates)
+    if not prune:
+        every = np.zeros(len(slots), dtype=bool)
+        every[cand] = True
+        return _evaluate(base, model, slots, m, every, candidates, tol_mm, tol_deg, None, angle_deg, mm_range)
     starts = _Lts(base, model, slots, m.p_world).starts(cand) if 3 * len(cand) > model.n_unknowns else [cand]
 
     def mask(idx: np.ndarray) -> BoolArray:

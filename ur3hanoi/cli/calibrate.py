@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ur3hanoi.cli.common import SYMLINK_NOTE, input_file, shown
-from ur3hanoi.cli.options import TABLE_KEYS, UsageError
+from ur3hanoi.cli.options import ACCEPT_HELP, TABLE_KEYS, UsageError, check_accept, slot
 from ur3hanoi.errors import printable, quote
 
 
@@ -15,11 +15,15 @@ def add(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("calibrate", help="fit a station's tower grid to taught poses (robust least squares)",
                        description="Fit the tower origins, height step, approach and tool yaw of a station to "
                                    "taught joint poses (or to every entry present in a lab-format table); "
-                                   "everything else comes from --base. Gross errors (a typo in one joint, swapped "
-                                   "or copied entries) are named and left out, never a reason to stop: the report "
-                                   "gives every point's deviation [mm] and the suspects worst first, and the "
-                                   "station is written only if the remaining fit is sound. Towers and heights are "
-                                   "numbered from 1. See `ur3hanoi.calibrate.taught` for the file format.")
+                                   "everything else comes from --base. A gross error (the home pose, a pose in "
+                                   "the wrong slot, a typo in one joint, copied entries) is found by what explains "
+                                   "the most: the point whose removal leaves the others consistent with each "
+                                   "other, the block size and the base's layout; it is named and left out. When it "
+                                   "is its tower's only contact, or the points cannot tell which of two is wrong, "
+                                   "nothing is written (exit 2) and the message says which and what to do. The "
+                                   "report gives every point's deviation [mm] and the suspects worst first. Towers "
+                                   "and heights are numbered from 1. See `ur3hanoi.calibrate.taught` for the file "
+                                   "format.")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--taught", metavar="FILE", help="taught-points YAML (units: deg|rad; points: [...])")
     src.add_argument("--from-table", metavar="FILE", help="lab-format table whose entries are the taught points")
@@ -29,6 +33,7 @@ def add(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", required=True, metavar="OUT",
                    help=f"calibration YAML to write ({SYMLINK_NOTE}; never one of the inputs)")
     p.add_argument("--name", help="station name written to OUT (default: OUT's file name without extension)")
+    p.add_argument("--accept", type=slot, action="append", metavar="T,H", help=ACCEPT_HELP)
     p.add_argument("--json", action="store_true",
                    help="print one JSON object (entries, suspects, fit) instead of the report; messages go to "
                         "stderr")
@@ -41,6 +46,7 @@ def run(args: argparse.Namespace) -> int:
     from ur3hanoi.audit import audit_taught
     from ur3hanoi.calibrate import fit_station, write_calibration
     from ur3hanoi.calibrate.taught import load_taught, taught_from_recorded
+    from ur3hanoi.calibrate.verdict import accepted_lines
     from ur3hanoi.io.atomic import check_output
     from ur3hanoi.io.schema import Text
     from ur3hanoi.station.calibration import load_station
@@ -65,7 +71,10 @@ def run(args: argparse.Namespace) -> int:
         table = read_recorded_table(args.from_table, args.key)
         taught, shared = taught_from_recorded(table), table.shared_above
         taught_label = f"{Path(args.from_table).as_posix()} key {args.key}"
-    fit = fit_station(base, taught, name=args.name or printable(out.stem, name_spec.max_len), source=str(args.output))
+    contacts = {(p.tower, p.height) for p in taught.points if p.k == 0}
+    accept = check_accept(args.accept, contacts, taught_label)
+    fit = fit_station(base, taught, name=args.name or printable(out.stem, name_spec.max_len), source=str(args.output),
+                      accept=accept)
     report = audit_taught(fit, taught, args.key or "Q", shared)
     print(json.dumps(report.to_json()) if args.json else report.text())
     sys.stdout.flush()
@@ -74,6 +83,8 @@ def run(args: argparse.Namespace) -> int:
                       inputs=inputs)
     for w in fit.warnings:
         print(f"ur3hanoi: warning: {w}", file=sys.stderr)
+    for line in accepted_lines(fit.points, fit.accepted, Path(args.base).as_posix()):
+        print(line, file=sys.stderr if args.json else sys.stdout)
     exact = " (exact fit: add points to check it)" if fit.dof == 0 else ""
     left_out = len(fit.points) - fit.n_used
     print(f"wrote {shown(args.output)}: fitted {', '.join(fit.fitted_params)} from {fit.n_used} of "

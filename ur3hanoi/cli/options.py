@@ -108,6 +108,26 @@ def slot(text: str) -> tuple[int, int]:
     return int(values[0]), int(values[1])  # type: ignore[arg-type]
 
 
+ACCEPT_HELP = ("accept the contact pose taught at tower T height H on your word (repeatable): its tower is placed "
+               "where it says even when the other points and the base's layout put it elsewhere (a tower that "
+               "really stands apart); the output says so")
+"""``--accept``'s help, one text for ``calibrate`` and ``teach``."""
+
+
+def check_accept(accept: list[tuple[int, int]] | None, contacts: set[tuple[int, int]], where: str
+                 ) -> set[tuple[int, int]]:
+    """The ``--accept T,H`` slots (1-based) as 0-based ``(tower, height)``; each must name a contact pose taught in
+    ``where`` (``contacts``: its taught contact slots, 0-based)."""
+    out = set()
+    for t, h in accept or ():
+        if (t - 1, h - 1) not in contacts:
+            taught = ", ".join(f"{a + 1},{b + 1}" for a, b in sorted(contacts)) or "none"
+            raise UsageError(f"--accept {t},{h} is invalid: no contact pose is taught at tower {t} height {h} in "
+                             f"{where} (taught: {taught})")
+        out.add((t - 1, h - 1))
+    return out
+
+
 def check_number(option_name: str, value: int | None, hi: int, what: str, why: str = "") -> None:
     """``value`` (1-based) of ``option_name`` must be in 1..``hi``; ``why`` says where the bound comes from."""
     if value is not None and not 1 <= value <= hi:

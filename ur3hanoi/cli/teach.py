@@ -15,7 +15,17 @@ from typing import TYPE_CHECKING, Any
 
 from ur3hanoi.cli import exit_codes
 from ur3hanoi.cli.common import SYMLINK_NOTE, input_file, shown
-from ur3hanoi.cli.options import DRIVER_WAIT, TABLE_KEYS, UsageError, check_number, option, slot, station_number
+from ur3hanoi.cli.options import (
+    ACCEPT_HELP,
+    DRIVER_WAIT,
+    TABLE_KEYS,
+    UsageError,
+    check_accept,
+    check_number,
+    option,
+    slot,
+    station_number,
+)
 from ur3hanoi.cli.ros2 import add_dds_options
 
 if TYPE_CHECKING:
@@ -62,6 +72,7 @@ def add(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--record-now", type=slot, metavar="T,H",
                    help="no terminal session: record the pose the driver publishes now as tower T height H "
                         "(waits until the arm is still), print the feedback and exit")
+    p.add_argument("--accept", type=slot, action="append", metavar="T,H", help=ACCEPT_HELP)
     p.add_argument("--finish", action="store_true",
                    help="fit TAUGHT and write the outputs (no driver needed; after --record-now: after recording)")
     p.add_argument("--master", metavar="URI", help="with --via ros: ROS master URI (default: $ROS_MASTER_URI, else "
@@ -154,7 +165,8 @@ def _session(args: argparse.Namespace, base: Station, base_label: str, taught: T
     arm, names = _connect(args)
     teacher = None
     try:
-        teacher = Teacher(base, base_label, taught, arm, names, args.start - 1)
+        accept = {(t - 1, h - 1) for t, h in args.accept or ()}
+        teacher = Teacher(base, base_label, taught, arm, names, args.start - 1, accept)
         if args.record_now is not None:
             _record_now(teacher, args.record_now, args.wait)
             return exit_codes.OK, teacher.taught
@@ -226,6 +238,7 @@ def _finish(args: argparse.Namespace, base: Station, base_label: str, taught: Ta
     """Fit, print the audit, write the calibration and the table key, say how accurate it is and what to run."""
     from ur3hanoi.audit import audit_taught
     from ur3hanoi.calibrate import fit_station, write_calibration
+    from ur3hanoi.calibrate.verdict import accepted_lines
     from ur3hanoi.cli.tables import write_key
     from ur3hanoi.errors import TaughtPointsError
     from ur3hanoi.teach.feedback import feedback
@@ -234,12 +247,16 @@ def _finish(args: argparse.Namespace, base: Station, base_label: str, taught: Ta
         raise TaughtPointsError(f"{shown(taught.path)}: no point recorded yet: nothing to calibrate",
                                 source=str(taught.path))
     points = taught.taught()
-    fit = fit_station(base, points, name=shown(station_out.stem)[:255], source=str(station_out))
+    accept = check_accept(args.accept, {(p.tower, p.height) for p in points.points if p.k == 0},
+                          taught.path.as_posix())
+    fit = fit_station(base, points, name=shown(station_out.stem)[:255], source=str(station_out), accept=accept)
     print(audit_taught(fit, points).text())
     write_calibration(station_out, fit, points, base, taught_label=taught.path.as_posix(), base_label=base_label,
                       inputs=[input_file(args.base), taught.path])
-    fb = feedback(base, points, base_label)
-    worst = max((r.off_mm for r in fb.rows if not math.isnan(r.off_mm)), default=math.nan)
+    for line in accepted_lines(fit.points, fit.accepted, base_label):
+        print(line)
+    fb = feedback(base, points, base_label, accept)
+    worst = max((r.off_mm for r in fb.rows if not math.isnan(r.off_mm) and fit.used[r.index]), default=math.nan)
     exact = ("an exact fit (one point per tower): each tower origin is where its taught pose put it, as accurate "
              "as that pose" if fit.dof == 0 else f"residual rms {fit.rms_mm:.2f} mm over {fit.n_used} points")
     print(f"wrote {shown(station_out)}: {exact}; every point within {worst:.1f} mm of where the others put it; "

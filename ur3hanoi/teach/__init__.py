@@ -10,8 +10,8 @@ Module map (one concept each):
 - :mod:`~ur3hanoi.teach.stillness`: is the arm still (no joint moved more than 0.05 deg in 0.5 s)?
 - :mod:`~ur3hanoi.teach.taught_file`: the session's taught-points file, written atomically at every record.
 - :mod:`~ur3hanoi.teach.advice`: which pose to record next, and why (the audit's ``unchecked`` rule).
-- :mod:`~ur3hanoi.teach.layout`: a point the others cannot check, checked against the base's tower layout.
-- :mod:`~ur3hanoi.teach.feedback`: every point's residual and the suspects, after each record.
+- :mod:`~ur3hanoi.teach.feedback`: every point's distance from where the others put it and the point that is
+  wrong (the calibration's own judgement, :mod:`ur3hanoi.calibrate.consensus`), after each record.
 - :mod:`~ur3hanoi.teach.jog`: Cartesian jog steps by closed-form IK, refused with their reason.
 - :mod:`~ur3hanoi.teach.session`: the session's state and actions (record, undo, skip, jog...).
 - :mod:`~ur3hanoi.teach.terminal`: keys without Enter and a live status in a plain terminal.

@@ -1,35 +1,31 @@
-"""What teach says after each record from the third point on: every point's residual and the suspects, so a bad
-pose is named the moment it is taught.
+"""What teach says after each record from the third point on: every point's distance from where the others put it,
+and the point that is wrong, so a bad pose is named the moment it is taught.
 
-Each contact is judged where it can be judged best:
-
-- a point the others check without it (the audit's rule, :func:`ur3hanoi.calibrate.grid_fit.removable`: its tower
-  has another point, or the step between levels is fitted) is judged by the calibration's own robust fit
-  (:func:`ur3hanoi.calibrate.fit_station`, exactly what ``calibrate`` will say): its residual is its distance from
-  the grid fitted to the other points, its suspects are the fit's;
-- a point the others cannot check (the only one of its tower: with one point per tower, every point) is judged
-  against the base calibration's layout fitted to the other points (:mod:`ur3hanoi.teach.layout`), and named when
-  more than the audit's flag distance (:data:`ur3hanoi.audit.rule.CONTACT_FLAG_MM`, 8 mm) off.
-
-Above poses (a hand-edited file may hold them) are judged by the fit only.
+The judgement is the calibration's own (:func:`ur3hanoi.calibrate.prepare.taught_consensus`, what ``calibrate``
+and ``f`` decide): a point that shares its tower with another is judged by the other points, a tower taught once
+by the base calibration's layout moved and turned onto the other towers, each against the audit's always-flagged
+distance (:data:`ur3hanoi.calibrate.limits.CONTACT_FLAG_MM`, 8 mm); which point is wrong is the one whose removal
+leaves the others consistent (:mod:`ur3hanoi.calibrate.consensus`), named with what probably happened (the arm at
+home, the wrong slot, a typo in one joint, not on the block). It works before every tower is taught too. The
+robust fit's finer suspects (over its own thresholds of a few mm) are named after it.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from dataclasses import dataclass
 
-import numpy as np
-
-from ur3hanoi.audit.rule import CONTACT_FLAG_MM
 from ur3hanoi.calibrate import CalibrationFit, fit_station
-from ur3hanoi.calibrate.grid_fit import GridSolution, choose_model, leave_one_out, measure, removable, solve
-from ur3hanoi.calibrate.taught import TaughtPoints
+from ur3hanoi.calibrate.evidence import BY_LAYOUT as LAYOUT
+from ur3hanoi.calibrate.evidence import BY_POINTS as POINTS
+from ur3hanoi.calibrate.limits import CONTACT_FLAG_MM
+from ur3hanoi.calibrate.prepare import taught_consensus
+from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
+from ur3hanoi.calibrate.verdict import named_text, refusal, where_text
 from ur3hanoi.errors import TaughtPointsError, printable
 from ur3hanoi.station.calibration import Station
-from ur3hanoi.station.grid import ON, contact_point_world
-from ur3hanoi.tables.ik_table import pose_label
-from ur3hanoi.teach.layout import check_layout
+from ur3hanoi.station.grid import pose_label
 
 FIRST_FEEDBACK = 3
 """Feedback starts with this many points (one per tower of the lab's three)."""
@@ -87,65 +83,60 @@ class Feedback:
         return out
 
 
-def _free_deviation(base: Station, slots: list[tuple[int, int, int]], p_world: np.ndarray
-                    ) -> tuple[np.ndarray, np.ndarray]:
-    """Per point: leave-one-out distance [mm] under the calibration's own model, and whether it is checkable."""
-    n = len(slots)
-    model = choose_model(base, slots)
-    if model is None:
-        return np.full(n, np.nan), np.zeros(n, dtype=bool)
-    can = removable(model, slots)
-    sol: GridSolution = solve(base, model, slots, p_world)
-    dev, _ = leave_one_out(model, slots, p_world, sol)
-    return np.linalg.norm(dev, axis=1) * 1e3, can
+def _line(reason: str) -> str:
+    """A suspect's reason, saying what to do once."""
+    return reason if reason.rstrip("?").endswith("re-record it") else f"{reason}: re-record it?"
 
 
-def feedback(base: Station, taught: TaughtPoints, base_label: str) -> Feedback:
-    """Judge the points of ``taught`` (see the module docstring)."""
+def feedback(base: Station, taught: TaughtPoints, base_label: str, accept: Collection[tuple[int, int]] = ()
+             ) -> Feedback:
+    """Judge the points of ``taught`` (see the module docstring); ``accept``: the ``(tower, height)`` slots
+    (0-based) taken on the student's word."""
     points = taught.points
-    slots = [(p.tower, p.height, p.k) for p in points]
-    m = measure(base, [p.q for p in points])
+    c, ev = taught_consensus(base, taught, accept, base_label)
     fit: CalibrationFit | None = None
     problem = ""
     try:
-        fit = fit_station(base, taught)
+        fit = fit_station(base, taught, accept=accept)
         problem = fit.problem
     except TaughtPointsError as exc:
         problem = str(exc).split(": ", 1)[-1]
-    free_mm, checkable = _free_deviation(base, slots, m.p_world)
-    contacts = [i for i, s in enumerate(slots) if s[2] == ON]
-    grid_mm = np.array([contact_point_world(base, points[i].tower, points[i].height) for i in contacts]) * 1e3
-    pivot = np.mean(np.asarray(base.tower_origins, dtype=float), axis=0) * 1e3
-    layout = check_layout(grid_mm.reshape(-1, 3), m.p_world[contacts].reshape(-1, 3) * 1e3, pivot, CONTACT_FLAG_MM)
-    layout_dev = dict(zip(contacts, layout.deviation_mm.tolist(), strict=True))
-
-    suspects: list[tuple[float, int, str]] = []
-    fit_suspects = {s.index: s for s in fit.suspects} if fit is not None else {}
+    judged = c.chosen
+    suspects: list[tuple[int, str]] = []
+    if c.kind == "named":
+        i = c.wrong[0]
+        suspects.append((i, f"{_label(points[i])} is {where_text(ev, c, i)}; {named_text(ev, c, i, points)}"))
+    elif c.kind == "undecided":
+        suspects.append((c.wrong[0], refusal(ev, c, points)))
+    if c.kind == "undecided" or (c.kind == "named" and c.alone):
+        problem = ""  # the line above says why, and what to do
+    elif fit is not None:  # the fit's finer suspects, among the points the others check
+        suspects += [(s.index, f"{_label(points[s.index])} is suspect: {_line(s.reason)}") for s in fit.suspects
+                     if s.index not in c.wrong and judged.by[s.index] != LAYOUT]
     rows = []
+    flagged = {i for i, _ in suspects} | set(c.wrong)
     for i, p in enumerate(points):
-        label = pose_label(p.tower, p.height, p.k).removesuffix(" on")
-        if checkable[i]:
-            off, by = float(free_mm[i]), BY_POINTS
-            suspect = i in fit_suspects
-            if suspect:
-                s = fit_suspects[i]
-                suspects.append((s.severity, i, f"{label} is suspect: {s.reason}: re-record it?"))
-        elif i in layout_dev:
-            off, by = layout_dev[i], BY_LAYOUT
-            suspect = i in layout.suspects
-            if suspect:
-                hedge = (" (the points cannot say for sure which one is off: this is the likeliest)"
-                         if layout.ambiguous else "")
-                suspects.append((off / CONTACT_FLAG_MM, i, f"{label} is {off:.1f} mm from where the other points put "
-                                 f"it (with the tower spacing and block size of {printable(base_label)}): re-record "
-                                 f"it?{hedge}"))
-        else:
-            off, by, suspect = math.nan, "", i in fit_suspects
-        rows.append(PointCheck(index=i, label=label, off_mm=off, by=by, suspect=suspect))
-    suspects.sort(key=lambda s: -s[0])
-    shift = tuple(float(x) for x in layout.shift_mm)
-    return Feedback(rows=tuple(rows), suspects=tuple((i, why) for _, i, why in suspects), fit=fit, problem=problem,
-                    layout_turn_deg=layout.theta_deg, layout_shift_mm=(shift[0], shift[1], shift[2]))
+        by = judged.by[i]
+        rows.append(PointCheck(index=i, label=_label(p), off_mm=float(judged.off_mm[i]),
+                               by=BY_POINTS if by == POINTS else BY_LAYOUT if by == LAYOUT else "",
+                               suspect=i in flagged))
+    layout = judged.layout
+    turn = math.degrees(layout.theta) if layout is not None else 0.0
+    sx, sy, sz = (float(v) for v in layout.shift) if layout is not None else (0.0, 0.0, 0.0)
+    return Feedback(rows=tuple(rows), suspects=tuple(suspects), fit=fit, problem=problem, layout_turn_deg=turn,
+                    layout_shift_mm=(sx, sy, sz))
 
 
-__all__ = ["BY_LAYOUT", "BY_POINTS", "FIRST_FEEDBACK", "Feedback", "PointCheck", "feedback"]
+def finish_problem(base: Station, taught: TaughtPoints, accept: Collection[tuple[int, int]] = ()) -> str:
+    """Why the calibration cannot be written from the points taught ("" when it can): what ``f`` checks first."""
+    try:
+        return fit_station(base, taught, accept=accept).problem
+    except TaughtPointsError as exc:
+        return str(exc).split(": ", 1)[-1]
+
+
+def _label(p: TaughtPoint) -> str:
+    return pose_label(p.tower, p.height, p.k).removesuffix(" on")
+
+
+__all__ = ["BY_LAYOUT", "BY_POINTS", "FIRST_FEEDBACK", "Feedback", "PointCheck", "feedback", "finish_problem"]

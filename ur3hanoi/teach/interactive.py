@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 
+from ur3hanoi.teach.feedback import finish_problem
 from ur3hanoi.teach.jog import JOG_ACCEL_RAD_S2, JOG_SPEED_RAD_S, JOG_STEPS_MM
 from ur3hanoi.teach.session import Teacher
 from ur3hanoi.teach.stillness import STILL_TOL_DEG, STILL_WINDOW_S
@@ -52,12 +53,16 @@ class _Picker:
 
 
 def _finish_problem(teacher: Teacher) -> str:
-    """Why ``f`` cannot finish yet ("" when it can): the fit needs a contact on every tower."""
+    """Why ``f`` cannot finish yet ("" when it can): the fit needs a contact on every tower, and nothing is written
+    from a fit that is not sound (a wrong point that is its tower's only contact, say)."""
     have = {p.tower for p in teacher.taught.points if p.k == 0}
     lacking = [str(t + 1) for t in range(teacher.base.n_towers) if t not in have]
     if lacking:
         return (f"cannot finish yet: tower(s) {', '.join(lacking)} have no contact pose (the fit needs one on every "
                 "tower); record them, or Ctrl-C to stop here (the points are saved)")
+    problem = finish_problem(teacher.base, teacher.taught.taught(), teacher.accept)
+    if problem:
+        return f"cannot finish yet: {problem} (u undoes the last point; Ctrl-C stops here, the points are saved)"
     return ""
 
 

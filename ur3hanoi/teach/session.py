@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Collection
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,12 +69,14 @@ class Teacher:
         taught: the session's file (maybe continued).
         driver: the connected driver; names: how messages name it.
         start: the tower holding the blocks (0-based).
+        accept: the ``(tower, height)`` slots (0-based) whose contacts the student vouches for (``--accept``).
     """
 
     def __init__(self, base: Station, base_label: str, taught: TaughtFile, driver: Driver, names: DriverNames,
-                 start: int) -> None:
+                 start: int, accept: Collection[tuple[int, int]] = ()) -> None:
         self.base, self.base_label, self.taught = base, base_label, taught
         self.driver, self.names, self.start = driver, names, start
+        self.accept = frozenset(accept)  # (tower, height) 0-based: contacts taken on the student's word
         self.jogger = Jogger(base)
         self.simulated = driver.simulated()  # asked once: a master lost later must not make it the real arm
         self.skipped: set[tuple[int, int]] = set()
@@ -157,7 +160,7 @@ class Teacher:
         self.extra = None
         self.skipped.discard((named.tower, named.height))
         if len(self.taught.points) >= FIRST_FEEDBACK:
-            fb = feedback(self.base, self.taught.taught(), self.base_label)
+            fb = feedback(self.base, self.taught.taught(), self.base_label, self.accept)
             lines += fb.lines(self.base_label)
             if fb.suspects:
                 point = self.taught.points[fb.suspects[0][0]]
