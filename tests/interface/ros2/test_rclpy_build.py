@@ -1,8 +1,9 @@
 """ur3hanoi.interface.ros2.rclpy_build: the vendored texts' RIHS01 hashes (that the texts are upstream's:
 tests/interface/urdriver/test_facts.py) as an independent implementation computes them (rosbags,
-tests/support/rosidl_oracle.py), the environment's name follows its pins, texts and build files; then (marker rclpy) the built environments: every type hash the rosidl generators wrote equals
-rosbags', the generated classes carry the texts' fields and constants, and ur3hanoi's own Python imports them through
-the lines ``ros2-env`` prints."""
+tests/support/rosidl_oracle.py), the environment's name follows its pins, a package's key its texts and build files;
+then (marker rclpy) the built environments: every type hash the rosidl generators wrote equals rosbags', the generated
+classes carry the texts' fields and constants, and ur3hanoi's own Python imports them through the lines ``ros2-env``
+prints."""
 
 from __future__ import annotations
 

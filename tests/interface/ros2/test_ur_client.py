@@ -55,6 +55,7 @@ def test_solves_one_block_and_halts_on_a_dropped_block(tmp_path: Path) -> None:
     assert code == 0, err
     outcome = json.loads(out.strip().splitlines()[-1])
     assert outcome["status"] == "solved" and outcome["ros_distro"] == "jazzy"
+    assert outcome["path_deviation_mm"] < 2.0 and outcome["joint_states_measured"] > 100 * outcome["executed_s"]
     ok = json.loads((tmp_path / "ok.json").read_text())
     assert [(b["block"], b["tower"], b["height"]) for b in ok["final"]["blocks"]] == [(1, 3, 1)]
     assert ok["goals"]["aborted"] == 0 and ok["goals"]["rejected"] == 0 and ok["goals"]["succeeded"] >= 3

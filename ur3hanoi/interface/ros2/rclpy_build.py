@@ -8,13 +8,14 @@ in with ``LD_LIBRARY_PATH`` set, so they go into a virtual environment of their 
 
 ``control_msgs`` and ``ur_msgs`` are not on PyPI: they are built here from their official texts (vendored in
 :data:`ur3hanoi.interface.urdriver.facts.MSG_TEXTS`, provenance in its README; ROS 1 reads the same ``ur_msgs``) with
-the rosidl generators of the same wheels and plain cmake + make, each message package into a prefix of its own. ``control_msgs``'s FollowJointTrajectory has two
-layouts: Humble (4.x) and Jazzy (5.x) share one, Kilted and later (>= 6.3.0) add ``index`` fields to the feedback,
-so the Jazzy wheels get the first and the Kilted wheels the second: a robot on Humble or Jazzy needs
-``--distro jazzy`` (the default), one on Kilted or Lyrical ``--distro kilted``.
+the rosidl generators of the same wheels and plain cmake + make, each message package into a prefix of its own.
+``control_msgs``'s FollowJointTrajectory has two layouts: Humble (4.x) and Jazzy (5.x) share one, Kilted and later
+(>= 6.3.0) add ``index`` fields to the feedback, so the Jazzy wheels get the first and the Kilted wheels the second: a
+robot on Humble or Jazzy needs ``--distro jazzy`` (the default), one on Kilted or Lyrical ``--distro kilted``.
 
-One environment per (wheels, Python, pins and texts): ``<cache>/ros2-<wheels>-py<X.Y>-<key>``, where the key hashes
-the pinned packages and every message text, so a change is a new folder, never a stale one. ``manifest.json``,
+One environment per (wheels, Python, pins): ``<cache>/ros2-<wheels>-py<X.Y>-<key>``, where the key hashes the pinned
+packages, so other pins are a new folder, never a stale one; in it, a message package is built again whenever its
+own key changes (:func:`package_key`: its texts, dependencies and build files). ``manifest.json``,
 written last, marks it complete and lists what a process needs (:mod:`ur3hanoi.interface.ros2.rclpy_env` reads
 it). A build holds a lock; a folder left without a manifest by a killed build is removed and built again.
 """

@@ -14,6 +14,8 @@ Modules, one concept each (importing this package needs neither ROS nor MuJoCo):
 - :mod:`~ur3hanoi.interface.urdriver.client`: what a client's binding provides (``DriverTransport``).
 - :mod:`~ur3hanoi.interface.urdriver.station`: the station without its transport (``DriverStation``).
 - :mod:`~ur3hanoi.interface.urdriver.solve`: the plan on the driver with the lab's checks (``run_driver_solve``).
+- :mod:`~ur3hanoi.interface.urdriver.joint_record`: the joint states a client received, in bounded memory.
+- :mod:`~ur3hanoi.interface.urdriver.path_deviation`: how closely the executed suction point followed the plan.
 - :mod:`~ur3hanoi.interface.urdriver.loopback`: client and station in one process on the CPU clock.
 
 Bindings: :mod:`ur3hanoi.interface.ros1` (``ur_server``, ``ur_client``) and :mod:`ur3hanoi.interface.ros2`.
