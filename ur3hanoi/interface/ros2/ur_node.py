@@ -18,8 +18,9 @@ from typing import Any, Protocol
 from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 from ur3hanoi.interface.ros2.errors import RclpyUnavailableError
 from ur3hanoi.interface.ros2.rclpy_env import import_interfaces, import_rclpy
-from ur3hanoi.interface.ros2.ur_driver import FEEDBACK_HZ, SPEED_SCALING_HZ, IoStatesMessage, set_duration
+from ur3hanoi.interface.ros2.ur_driver import FEEDBACK_HZ, SPEED_SCALING_HZ, set_duration
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1_JOINT_STATE_ORDER, DriverNames
+from ur3hanoi.interface.urdriver.io import IoStatesMessage
 from ur3hanoi.interface.urdriver.station import CycleOutput, DriverStationOptions
 
 
