@@ -63,6 +63,7 @@ class Run:
     code: int
     outcome: dict[str, Any]
     report: dict[str, Any]
+    calibration: str = "lab_sim"
     load: float = field(default_factory=lambda: os.getloadavg()[0])
 
     def blocks(self) -> list[tuple[int, int | None, int | None]]:
@@ -141,7 +142,7 @@ def rclpy_prefix() -> str:
     return "env " + " ".join(f"{k}={shlex.quote(v)}" for k, v in env.variables("jazzy").items())
 
 
-def ros2_run(tmp: Path, label: str, prefix: str, station: str, solve: str) -> Run:
+def ros2_run(tmp: Path, label: str, prefix: str, station: str, solve: str, calibration: str) -> Run:
     """``ros2-station STATION`` and ``ros2-solve SOLVE --json`` in one private network namespace."""
     ur3hanoi = f"{prefix} {shlex.quote(sys.executable)} -m ur3hanoi.cli"
     script = f"""{PRELUDE}
@@ -159,7 +160,8 @@ kill -INT $ST; wait $ST
     if not (tmp / "solve.code").exists():
         raise RuntimeError(f"ros2-station {station}: {(tmp / 'st.err').read_text().strip()[-300:]}")
     outcome = _outcome((tmp / "solve.out").read_text(), (tmp / "solve.err").read_text())
-    return Run(label, int((tmp / "solve.code").read_text()), outcome, json.loads((tmp / "report.json").read_text()))
+    return Run(label, int((tmp / "solve.code").read_text()), outcome, json.loads((tmp / "report.json").read_text()),
+               calibration)
 
 
 # ------------------------------------------------------------------------------------------------------ rows
@@ -169,22 +171,33 @@ def loop_text(report: dict[str, Any]) -> str:
             + f"{c['late_cycles']:>7}/{c['cycles']}")
 
 
+def plan_at(calibration: str, slider: float) -> tuple[float, float]:
+    """The plan's own cycle time [s] and its time at ``slider``: the motion slowed, the dwells as they are."""
+    from ur3hanoi.plan import PlanConfig, plan_solve
+    from ur3hanoi.station.calibration import load_station
+
+    plan = plan_solve(load_station(calibration), 0, 2, 3, PlanConfig())
+    return plan.duration_s, plan.motion_s / slider + plan.dwell_total_s
+
+
 def driver_row(r: Run, n: int) -> str:
     o, rate = r.outcome, r.report["control"]["rate_hz"]
-    head = f"{r.label:<34}{rate:>5g}"
+    head = f"{r.label:<28}{rate:>5g}"
     if r.code != 0:
         return f"{head}  exit {r.code}: {o.get('error', o)}"
-    ex, plan = o["executed_s"], o["plan_duration_s"]
+    ex = o["executed_s"]
+    own, at_slider = plan_at(r.calibration, r.report["driver"]["speed_slider"])
     vertical = o.get("vertical_path_deviation_mm")
     js = o.get("joint_states_measured", 0) / ex if ex > 0 else 0.0
-    return (f"{head}{ex:>10.2f}{plan:>8.2f}{ex / plan:>7.3f}  {'yes' if r.in_place(n) else 'NO':<7}"
-            f"{o.get('path_deviation_mm', float('nan')):>8.3f}{'-' if vertical is None else f'{vertical:.3f}':>8}"
-            f"{js:>7.0f}  {loop_text(r.report)}  {r.load:>4.1f}")
+    return (f"{head}{ex:>9.2f}{own:>8.2f}{at_slider:>9.2f}{ex / at_slider:>7.3f}  {'yes' if r.in_place(n) else 'NO':<6}"
+            f"{o.get('path_deviation_mm', float('nan')):>7.3f}{'-' if vertical is None else f'{vertical:.3f}':>7}"
+            f"{js:>6.0f} {loop_text(r.report)}  {r.load:>4.1f}")
 
 
-DRIVER_HEAD = (f"{'station, slider':<34}{'Hz':>5}{'exec [s]':>10}{'plan [s]':>8}{'ratio':>7}  {'blocks':<7}"
-               f"{'path':>8}{'vert.':>8}{'js/s':>7}  {'lag mean/worst':>13}{'late':>7}  load\n"
-               f"{'':<34}{'':>5}{'':>10}{'':>8}{'':>7}  {'':<7}{'[mm]':>8}{'[mm]':>8}{'':>7}  {'[ms]':>13}")
+DRIVER_HEAD = (f"{'':<28}{'':>5}{'executed':>9}{'plan':>8}{'plan at':>9}{'':>7}  {'blocks':<6}{'path':>7}"
+               f"{'vert.':>7}{'joint':>6} {'loop lag':>13}{'late':>7}\n"
+               f"{'station, slider':<28}{'Hz':>5}{'[s]':>9}{'[s]':>8}{'slider':>9}{'ratio':>7}  {'placed':<6}"
+               f"{'[mm]':>7}{'[mm]':>7}{'st/s':>6} {'mean/worst ms':>13}{'cycles':>7}  load")
 
 
 def halt_row(r: Run) -> str:
@@ -335,11 +348,11 @@ def ros2_runs(tmp: Path, prefix: str) -> tuple[list[Run], list[Run], list[Run]]:
         common = f"--driver ur --calibration {cal} --rate {hz}"
         for s in (1.0, 0.5):
             drivers.append(ros2_run(tmp, f"ROS 2 {cal}, slider {s:g}", prefix, f"{common} --speed-scaling {s:g}",
-                                    f"--driver ur --calibration {cal}"))
+                                    f"--driver ur --calibration {cal}", cal))
         halts.append(ros2_run(tmp, f"ROS 2 {cal} {hz} Hz", prefix, f"{common} --blocks 1 --drop-on-grasp 1",
-                              f"--driver ur --calibration {cal} --blocks 1"))
+                              f"--driver ur --calibration {cal} --blocks 1", cal))
     course = ros2_run(tmp, "ROS 2 ros2-solve via ur3e/command on ros2-station (bridge, 2 s)", prefix,
-                      "--calibration ur3e_sim --timing bridge", "--calibration ur3e_sim")
+                      "--calibration ur3e_sim --timing bridge", "--calibration ur3e_sim", "ur3e_sim")
     return drivers, halts, [course]
 
 
