@@ -19,8 +19,10 @@ Measures, each run against a fresh station (tower 1 -> 3):
 - the baselines: ``ros-solve`` through ``ur3/command`` on ``ros-station`` (the course interface) and ``ros2-solve``
   through ``ur3e/command`` on ``ros2-station`` in its bridge timing (every command a fixed 2 s, as the course's
   UR3e bridge): their wall time, commands, blocks;
-- one control cycle on the CPU clock (median over a 1-block loopback solve: the station core without middleware) and
-  with each middleware's publishing step (median over 3 s of idle cycles, a client subscribed) [us].
+- one control cycle on the CPU clock (median over a 1-block loopback solve: the station core without middleware,
+  cycles back to back) and at the control rate with each middleware's publishing step (median over 3 s of idle
+  cycles, a client subscribed) [us], wall and thread CPU time (a loop that sleeps between cycles finds its caches
+  cold when other programs ran meanwhile).
 Prints the load average beside the figures: the stations are Python loops and share the machine's cores.
 """
 
@@ -230,16 +232,29 @@ st = DriverStation(DriverStationOptions(calibration=sys.argv[1], n_blocks=1), la
 plan = plan_solve(st.station, 0, 2, 1, PlanConfig())
 cycle, times = st.cycle, []
 def timed():
-    t0 = time.perf_counter(); cycle(); times.append(time.perf_counter() - t0)
+    c0, t0 = time.thread_time(), time.perf_counter(); cycle()
+    times.append((time.perf_counter() - t0, time.thread_time() - c0))
 st.cycle = timed
 tr = LoopbackTransport(st); tr.connect()
 gc.collect()
 run_driver_solve(tr, plan, st.station.wiring)
-print(f"{1e6 * np.median(times):.0f} {len(times)}")
+wall, cpu = np.median(np.array(times), axis=0)
+print(f"{1e6 * wall:.0f} {1e6 * cpu:.0f} {len(times)}")
 """
-ROS1_PUBLISH_CODE = """
-import subprocess, sys, time
+MEASURE_CODE = """
+import time
 import numpy as np
+def measure(cycle, publish, rate):  # 3 s at rate: median wall and thread CPU [us] of the core and of publishing
+    period, tt, pc = 1.0 / rate, time.thread_time, time.perf_counter
+    rows = []
+    for _ in range(int(3 * rate)):
+        c0, w0 = tt(), pc(); cycle(); c1, w1 = tt(), pc(); publish(); c2, w2 = tt(), pc()
+        rows.append((w1 - w0, c1 - c0, w2 - w1, c2 - c1)); time.sleep(max(0.0, period - (w2 - w0)))
+    return [round(1e6 * x) for x in np.median(np.array(rows), axis=0)]
+"""
+ROS1_PUBLISH_CODE = MEASURE_CODE + """
+import subprocess, sys
+sys.setswitchinterval(0.0005)  # as ros-station's loop sets it (ur3hanoi.interface.ros1.server)
 from ur3hanoi.interface.ros1.env import import_rospy
 from ur3hanoi.interface.ros1.ur_server import RosDriverOptions, RosDriverServer
 rospy = import_rospy()
@@ -254,13 +269,9 @@ while time.monotonic() < end:  # serve until the client is connected
     st.cycle(); publish()
     if sel.select(timeout=0.008):
         break
-core, pub = [], []
-for _ in range(375):  # 3 s at 125 Hz
-    t0 = time.perf_counter(); st.cycle(); t1 = time.perf_counter(); publish(); t2 = time.perf_counter()
-    core.append(t1 - t0); pub.append(t2 - t1); time.sleep(max(0.0, 0.008 - (t2 - t0)))
+print(*measure(st.cycle, publish, 125.0))
 client.kill(); client.wait()
 rospy.signal_shutdown("done")
-print(f"{1e6 * np.median(core):.0f} {1e6 * np.median(pub):.0f}")
 """
 ROS1_CLIENT_CODE = """
 import os, time
@@ -269,9 +280,8 @@ t = RosDriverTransport(os.environ["ROS_MASTER_URI"], 60.0); t.connect()
 print("connected", flush=True)
 time.sleep(60)
 """
-ROS2_PUBLISH_CODE = """
-import subprocess, sys, time
-import numpy as np
+ROS2_PUBLISH_CODE = MEASURE_CODE + """
+import subprocess, sys
 from ur3hanoi.interface.ros2.ur_station import Ros2DriverOptions, Ros2DriverStation
 from ur3hanoi.interface.ros2.ur_node import DriverNode
 cal, rate = sys.argv[1], float(sys.argv[2])
@@ -287,12 +297,8 @@ while time.monotonic() < end:  # serve until the client is connected
     st.cycle(); node.publish()
     if sel.select(timeout=period):
         break
-core, pub = [], []
-for _ in range(int(3 * rate)):
-    t0 = time.perf_counter(); st.cycle(); t1 = time.perf_counter(); node.publish(); t2 = time.perf_counter()
-    core.append(t1 - t0); pub.append(t2 - t1); time.sleep(max(0.0, period - (t2 - t0)))
+print(*measure(st.cycle, node.publish, rate))
 client.kill(); client.wait(); node.close()
-print(f"{1e6 * np.median(core):.0f} {1e6 * np.median(pub):.0f}")
 """
 ROS2_CLIENT_CODE = """
 import time
@@ -303,22 +309,33 @@ time.sleep(60)
 """
 
 
+def _binding_line(what: str, middleware: str, out: subprocess.CompletedProcess[str]) -> str:
+    figures = out.stdout.split()
+    if len(figures) != 4:
+        return f"{what}: failed: {out.stderr.strip()[-300:]}"
+    core_wall, core_cpu, pub_wall, pub_cpu = figures
+    return (f"{what}, idle, a client subscribed: core {core_wall} us ({core_cpu} us CPU) + {middleware} publishing "
+            f"{pub_wall} us ({pub_cpu} us CPU) per cycle")
+
+
 def cycle_lines(prefix: str | None, ros1: bool) -> list[str]:
     """The cost of one control cycle [us] (see the module docstring)."""
     lines = []
     for cal, hz in (("lab_sim", 125), ("ur3e_sim", 500)):
         out = subprocess.run([sys.executable, "-c", CORE_CODE, cal], cwd=REPO, capture_output=True, text=True,
                              timeout=TIMEOUT_S)
-        us, n = [*out.stdout.split(), "?", "?"][:2]
-        lines.append(f"station core, {cal} {hz} Hz, active goals (CPU clock, {n} cycles): {us} us per cycle, "
-                     f"{float(us) / (1e4 / hz):.0f} % of the period" if us != "?" else out.stderr[-300:])
+        figures = out.stdout.split()
+        if len(figures) != 3:
+            lines.append(f"station core, {cal}: failed: {out.stderr.strip()[-300:]}")
+            continue
+        wall, cpu, n = figures
+        lines.append(f"station core, {cal} {hz} Hz, a 1-block solve on the CPU clock ({n} cycles, back to back): "
+                     f"{wall} us per cycle ({cpu} us CPU), {float(wall) / (1e4 / hz):.0f} % of the period")
     if ros1:
         with tempfile.TemporaryDirectory(prefix="bench_driver-") as d, ros1_env(Path(d)) as env:
             out = subprocess.run([sys.executable, "-c", ROS1_PUBLISH_CODE, ROS1_CLIENT_CODE], cwd=REPO, env=env,
                                  capture_output=True, text=True, timeout=TIMEOUT_S)
-        core, pub = [*out.stdout.split(), "?", "?"][:2]
-        lines.append(f"ros-station --driver ur, lab_sim 125 Hz, idle, a client subscribed: core {core} us + rospy "
-                     f"publishing {pub} us per cycle" if pub != "?" else out.stderr[-300:])
+        lines.append(_binding_line("ros-station --driver ur, lab_sim 125 Hz", "rospy", out))
     if prefix is not None:
         for cal, hz in (("lab_sim", 125), ("ur3e_sim", 500)):
             code = " ".join(shlex.quote(x) for x in (sys.executable, "-c", ROS2_PUBLISH_CODE, cal, str(hz),
@@ -326,9 +343,7 @@ def cycle_lines(prefix: str | None, ros1: bool) -> list[str]:
             script = f"{PRELUDE}\nexport ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST\n{prefix} {code}\n"
             out = subprocess.run(["unshare", "-n", "bash", "-c", script], cwd=REPO, capture_output=True, text=True,
                                  timeout=TIMEOUT_S)
-            core, pub = [*out.stdout.split(), "?", "?"][:2]
-            lines.append(f"ros2-station --driver ur, {cal} {hz} Hz, idle, a client subscribed: core {core} us + "
-                         f"rclpy publishing {pub} us per cycle" if pub != "?" else out.stderr[-300:])
+            lines.append(_binding_line(f"ros2-station --driver ur, {cal} {hz} Hz", "rclpy", out))
     return lines
 
 
