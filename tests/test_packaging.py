@@ -21,6 +21,7 @@ import pytest
 import yaml
 
 from tests.conftest import REPO
+from ur3hanoi.interface.urdriver.facts import MSG_TEXTS
 from ur3hanoi.io.resources import robot_dir, station_names, stations_dir
 
 pytestmark = pytest.mark.packaging
@@ -54,14 +55,16 @@ def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
-def test_wheel_carries_the_robot_folder_and_the_stations(wheel: Path) -> None:
+def test_wheel_carries_the_robot_folder_the_stations_and_the_message_texts(wheel: Path) -> None:
     names = set(zipfile.ZipFile(wheel).namelist())
     robot = f"ur3hanoi/robot/models/{robot_dir().name}"
     expected = {f"{robot}/{f}" for f in ("ur3.xml", "scene.xml", "LICENSE", "README.md", "CHANGELOG.md")}
     expected |= {f"{robot}/assets/{p.name}" for p in (robot_dir() / "assets").glob("*.stl")}
     expected |= {f"ur3hanoi/station/shipped/{n}.yaml" for n in station_names()}
     expected |= {"ur3hanoi/py.typed"}
-    assert len(expected) > 10
+    expected |= {f"ur3hanoi/interface/urdriver/msg_texts/{p.relative_to(MSG_TEXTS)}" for p in MSG_TEXTS.rglob("*")
+                 if p.is_file()}  # the UR driver's message texts (both ROS bindings build their classes from them)
+    assert len(expected) > 20
     assert expected <= names, f"missing from the wheel: {sorted(expected - names)}"
 
 

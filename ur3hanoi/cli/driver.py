@@ -86,12 +86,12 @@ def run_driver_solve_command(args: argparse.Namespace, transport: Any, make_plan
         transport.close()
     outcome.update(status="solved", exit_code=0, moves=len(result.moves), goals=result.goals,
                    wall_time_s=round(result.wall_time_s, 3), executed_s=round(result.executed_s, 3),
-                   approach_s=round(result.approach_s, 3))
+                   approach_s=round(result.approach_s, 3), **({} if result.path is None else result.path.as_dict()))
     if args.json:
         print(json.dumps(outcome))
     else:
         print(f"solved: {len(result.moves)} moves in {result.goals} goals, {result.executed_s:.1f} s (the plan: "
               f"{plan.duration_s:.1f} s)" + (f" after {result.approach_s:.1f} s to its start" if result.approach_s
-                                             else ""))
+                                             else "") + ("" if result.path is None else f"; {result.path.describe()}"))
     sys.stdout.flush()
     return 0

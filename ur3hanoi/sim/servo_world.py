@@ -23,6 +23,8 @@ in wall time). The robot is not a perfect tracker:
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
@@ -45,6 +47,13 @@ HOLD_FRICTION_NM = 1000.0
 """The clamp of :meth:`ServoWorld.hold_arm`: dry friction [N m] on every arm joint, far beyond the UR3's joint torques
 (MuJoCo's ``frictionloss`` constraint, stable at any stiffness)."""
 _MOVING_EPS = 1e-9  # [rad/s] a reference slower than this is at rest (a drop waits for motion)
+_EXACT = 1e-12  # [rad, rad/s] a reference this close to the target follows it exactly
+
+
+def _within(x: FloatArray, y: FloatArray) -> bool:
+    """``np.allclose(x, y, rtol=0, atol=1e-12)`` for a finite ``x``: every element within 1e-12 of ``y`` (False
+    where ``y`` is not finite)."""
+    return bool(np.abs(x - y).max() <= _EXACT)
 
 
 class ServoWorld(TaskWorld):
@@ -63,6 +72,11 @@ class ServoWorld(TaskWorld):
         lim = station.limits
         self.v_max = np.asarray(lim.v_max, dtype=float) * LIMIT_MARGIN
         self.a_max = np.asarray(lim.a_max, dtype=float) * LIMIT_MARGIN
+        # Per-cycle constants of _limit (the same products it computed every cycle, in the same order).
+        self._a_peak = self.a_max * PEAK_ACCELERATION
+        self._two_a_peak = 2.0 * self.a_max * PEAK_ACCELERATION
+        self._dv_peak = self._a_peak * self.config.period_s
+        self._inf = np.full(len(self.v_max), np.inf)
         self.slider = slider
         self.own_scaling = 1.0
         self.ref_q: FloatArray = station.q_home_array.copy()  # the robot's own reference [rad]
@@ -96,15 +110,17 @@ class ServoWorld(TaskWorld):
 
     def _limit(self, target: FloatArray) -> tuple[FloatArray, FloatArray]:
         """The robot's reference and velocity for this cycle towards ``target`` (see the module docstring)."""
+        # Once per control cycle (500 Hz on an e-Series): plain ufuncs, not np.clip/np.allclose (whose Python
+        # wrappers cost more than the arithmetic; the results are the same).
         dt = self.config.period_s
         step = target - self._target  # the target's own motion this cycle
         gap = self._target - self.ref_q  # how far behind the robot was
-        close = np.sign(gap) * np.minimum(np.abs(gap) / dt, np.sqrt(2.0 * self.a_max * PEAK_ACCELERATION * np.abs(gap)))
+        abs_gap = np.abs(gap)
+        close = np.sign(gap) * np.minimum(abs_gap / dt, np.sqrt(self._two_a_peak * abs_gap))
         want = step / dt + close
-        a_peak = self.a_max * PEAK_ACCELERATION
-        qd = np.clip(want, self.ref_qd - a_peak * dt, self.ref_qd + a_peak * dt)
-        qd = np.clip(qd, -self.v_max, self.v_max)
-        self.limited = not np.allclose(qd, want, rtol=0.0, atol=1e-12)
+        qd = np.minimum(np.maximum(want, self.ref_qd - self._dv_peak), self.ref_qd + self._dv_peak)
+        qd = np.minimum(np.maximum(qd, -self.v_max), self.v_max)
+        self.limited = not _within(qd, want)
         return self.ref_q + qd * dt, qd
 
     def _rescale(self, qd: FloatArray, qdd: FloatArray) -> None:
@@ -115,11 +131,13 @@ class ServoWorld(TaskWorld):
         if s <= 0.0:
             return
         v, a = np.abs(qd) / s, np.abs(qdd) / (s * s)  # the trajectory's own, in its time
-        with np.errstate(divide="ignore"):
-            fits = min(float(np.min(self.v_max / v)), float(np.sqrt(np.min(self.a_max / a))))
+        # limit / 0 = inf, without np.errstate (a costly context manager at 500 Hz) to silence the warning
+        fits_v = np.divide(self.v_max, v, out=self._inf.copy(), where=v != 0.0)
+        fits_a = np.divide(self.a_max, a, out=self._inf.copy(), where=a != 0.0)
+        fits = min(float(fits_v.min()), math.sqrt(float(fits_a.min())))
         goal = min(1.0, fits / self.slider)
         rate = SCALING_CHANGE_PER_S * self.config.period_s
-        self.own_scaling = float(np.clip(goal, self.own_scaling - rate, self.own_scaling + rate))
+        self.own_scaling = float(min(max(goal, self.own_scaling - rate), self.own_scaling + rate))
 
     def step(self, q: FloatArray, qd: FloatArray, qdd: FloatArray) -> None:
         """One control cycle towards the controller's target ``q`` [rad] (with its wall-time velocity ``qd`` [rad/s]
@@ -129,11 +147,11 @@ class ServoWorld(TaskWorld):
         target = np.asarray(q, dtype=float)
         ref, ref_qd = self._limit(target)
         self._rescale(np.asarray(qd, dtype=float), np.asarray(qdd, dtype=float))
-        exact = not self.limited and np.allclose(ref, target, rtol=0.0, atol=1e-12)
+        exact = not self.limited and _within(ref, target)
         acc = np.asarray(qdd, dtype=float) if exact else (ref_qd - self.ref_qd) / dt
         vel = np.asarray(qd, dtype=float) if exact else ref_qd
         self.ref_q, self.ref_qd, self._target = (target.copy() if exact else ref), vel, target.copy()
-        moving = bool(np.any(np.abs(vel) > _MOVING_EPS))
+        moving = bool((np.abs(vel) > _MOVING_EPS).any())
         self._motion_s = (0.0 if self._motion_s is None else self._motion_s + dt) if moving else None
         self._update_suction(self._motion_s)
         self._apply_hold(dt)

@@ -94,10 +94,9 @@ def test_the_station_answers_clients_of_either_text():
 
 
 def test_the_action_expands_like_genaction():
-    from ur3hanoi.interface.ros1.driver_msgs import AUTOGEN, TEXTS, action_texts
+    from ur3hanoi.interface.ros1.driver_msgs import AUTOGEN, action_texts, ros1_text
 
-    texts = action_texts("control_msgs/FollowJointTrajectory",
-                         (TEXTS / "control_msgs" / "FollowJointTrajectory.action").read_text())
+    texts = action_texts("control_msgs/FollowJointTrajectory", ros1_text("control_msgs/FollowJointTrajectory"))
     assert len(texts) == 7 and all(t.startswith(AUTOGEN) for t in texts.values())
     assert "actionlib_msgs/GoalID goal_id\nFollowJointTrajectoryGoal goal" in \
         texts["control_msgs/FollowJointTrajectoryActionGoal"]

@@ -1,15 +1,14 @@
-"""ur3hanoi.interface.ros2.rclpy_build: the vendored texts are upstream's (git blob ids), their RIHS01 hashes as an
-independent implementation computes them (rosbags, tests/support/rosidl_oracle.py), the environment's name follows
-its pins and texts; then (marker rclpy) the built environments: every type hash the rosidl generators wrote equals
-rosbags', the generated classes carry the texts' fields and constants, and ur3hanoi's own Python imports them through
-the lines ``ros2-env`` prints."""
+"""ur3hanoi.interface.ros2.rclpy_build: the vendored texts' RIHS01 hashes (that the texts are upstream's:
+tests/interface/urdriver/test_facts.py) as an independent implementation computes them (rosbags,
+tests/support/rosidl_oracle.py), the environment's name follows its pins, a package's key its texts and build files;
+then (marker rclpy) the built environments: every type hash the rosidl generators wrote equals rosbags', the generated
+classes carry the texts' fields and constants, and ur3hanoi's own Python imports them through the lines ``ros2-env``
+prints."""
 
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
-import re
 import subprocess
 import sys
 from pathlib import Path
@@ -23,8 +22,6 @@ from tests.support.rosidl_oracle import typestore
 from ur3hanoi.interface.ros2 import rclpy_build
 from ur3hanoi.interface.ros2.rclpy_build import WHEELS, MsgPackage, driver_packages, env_root, package_key
 from ur3hanoi.interface.ros2.rclpy_env import RclpyEnv
-
-IDL = Path(rclpy_build.__file__).parent / "idl"
 
 PINNED = {  # the rosidl generators' hashes of the vendored texts (Jazzy and Kilted wheels alike)
     "control_msgs/action/FollowJointTrajectory_Goal":
@@ -57,19 +54,6 @@ def _texts(layout: str) -> dict[str, str]:
     return out
 
 
-def _git_blob(data: bytes) -> str:
-    return hashlib.sha1(b"blob %d\0" % len(data) + data).hexdigest()
-
-
-def test_vendored_texts_are_upstreams_blobs() -> None:
-    """Every file is listed in the README with upstream's git blob id, and its bytes hash to that id."""
-    rows = re.findall(r"^\| `([^`]+)` \|.*\| ([0-9a-f]{40}) \|$", (IDL / "README.md").read_text(), re.MULTILINE)
-    files = sorted(str(p.relative_to(IDL)) for p in IDL.rglob("*") if p.is_file() and p.name != "README.md")
-    assert sorted(path for path, _ in rows) == files
-    for path, blob in rows:
-        assert _git_blob((IDL / path).read_bytes()) == blob, path
-
-
 @pytest.mark.parametrize("store", [Stores.ROS2_JAZZY, Stores.ROS2_KILTED])  # Humble has no type hashes
 @pytest.mark.parametrize("layout", sorted(WHEELS))
 def test_rosbags_computes_the_pinned_hashes(layout: str, store: Stores) -> None:
@@ -97,6 +81,11 @@ def test_environment_names_follow_pins_and_texts(tmp_path: Path) -> None:
     edited = MsgPackage(control.name, {**control.texts, "msg/JointTolerance.msg": "string name\n"},
                         control.dependencies)
     assert package_key(edited) != package_key(control)
+    key = package_key(control)
+    for template in ("_CMAKELISTS", "_PACKAGE_XML"):  # the build files made from the texts are inputs too
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(rclpy_build, template, getattr(rclpy_build, template) + "\n")
+            assert package_key(control) != key, template
 
 
 def test_a_missing_tool_is_one_line(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -43,7 +43,7 @@ def _read(tmp: Path, name: str) -> tuple[int, str, str]:
 def test_solves_one_block_and_halts_on_a_dropped_block(tmp_path: Path) -> None:
     env = build_env("jazzy")
     # 125 Hz (the UR3's rate): station and client both run Python here; the UR3e's 500 Hz is tested with the driver's
-    # own clients (test_ur_station.py) and measured in bench/bench_ros2_driver.py.
+    # own clients (test_ur_station.py) and measured in bench/bench_driver.py.
     station = f"{env.station_prefix()} $UR3HANOI ros2-station --driver ur --blocks 1 --rate 125"
     solve = f"{env.station_prefix()} {SOLVE}"
     script = "\n".join([*_with_station(f"{station} --report {tmp_path}/ok.json", f"{solve} --json", tmp_path, "ok"),
@@ -55,6 +55,7 @@ def test_solves_one_block_and_halts_on_a_dropped_block(tmp_path: Path) -> None:
     assert code == 0, err
     outcome = json.loads(out.strip().splitlines()[-1])
     assert outcome["status"] == "solved" and outcome["ros_distro"] == "jazzy"
+    assert outcome["path_deviation_mm"] < 2.0 and outcome["joint_states_measured"] > 100 * outcome["executed_s"]
     ok = json.loads((tmp_path / "ok.json").read_text())
     assert [(b["block"], b["tower"], b["height"]) for b in ok["final"]["blocks"]] == [(1, 3, 1)]
     assert ok["goals"]["aborted"] == 0 and ok["goals"]["rejected"] == 0 and ok["goals"]["succeeded"] >= 3
@@ -65,7 +66,7 @@ def test_solves_one_block_and_halts_on_a_dropped_block(tmp_path: Path) -> None:
     halt = json.loads((tmp_path / "halt.json").read_text())
     assert halt["final"]["at_home"] and not halt["final"]["suction_on"]
     assert halt["goals"]["canceled"] == 1
-    (h,) = halt["halts"]  # its latency (cycles from the feedback's loss to the cancel) is bench_ros2_driver.py's figure
+    (h,) = halt["halts"]  # its latency (cycles from the feedback's loss to the cancel) is bench_driver.py's figure
     assert isinstance(h["cycles"], int) and h["cycles"] >= 0, h
 
 

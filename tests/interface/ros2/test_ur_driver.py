@@ -12,7 +12,6 @@ import pytest
 from tests.support.rosidl_oracle import typestore
 from ur3hanoi.interface.ros2.rclpy_build import WHEELS, driver_packages
 from ur3hanoi.interface.ros2.ur_driver import (
-    IoStatesMessage,
     duration_s,
     goal_from_msg,
     io_from_msg,
@@ -24,7 +23,7 @@ from ur3hanoi.interface.ros2.ur_driver import (
 )
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS
 from ur3hanoi.interface.urdriver.goal import check_goal
-from ur3hanoi.interface.urdriver.io import IoStates
+from ur3hanoi.interface.urdriver.io import IoStates, IoStatesMessage
 
 
 def _types() -> dict[str, Any]:

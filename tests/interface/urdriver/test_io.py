@@ -1,8 +1,10 @@
-"""set_io as the UR drivers answer it (the pin mapping, success = false for the rest) and the io_states layout."""
+"""set_io as the UR drivers answer it (the pin mapping, success = false for the rest), the io_states layout and the
+one IOStates message a binding keeps."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 
 import pytest
 
@@ -13,7 +15,7 @@ from ur3hanoi.interface.urdriver.facts import (
     FUN_SET_FLAG,
     FUN_SET_TOOL_VOLTAGE,
 )
-from ur3hanoi.interface.urdriver.io import IoBoard, check_set_io
+from ur3hanoi.interface.urdriver.io import IoBoard, IoStates, IoStatesMessage, check_set_io
 
 
 @pytest.mark.parametrize("pin", [0, 7, 8, 15, 16, 17])
@@ -43,3 +45,41 @@ def test_a_write_reaches_the_outputs_at_the_next_cycle():
     assert t is not None
     io.cycle()
     assert io.applied(t) and io.tool_voltage == 24.0
+
+
+class Msgs:
+    """Message classes shaped like ``ur_msgs`` (keyword fields), as either binding passes them."""
+
+    @dataclass
+    class Digital:
+        pin: int = 0
+        state: bool = False
+
+    @dataclass
+    class Analog:
+        pin: int = 0
+        domain: int = 0
+        state: float = 0.0
+
+    @dataclass
+    class IOStates:
+        digital_in_states: list = field(default_factory=list)
+        digital_out_states: list = field(default_factory=list)
+        flag_states: list = field(default_factory=list)
+        analog_in_states: list = field(default_factory=list)
+        analog_out_states: list = field(default_factory=list)
+
+
+def test_the_kept_message_holds_each_cycles_states() -> None:
+    kept = IoStatesMessage(Msgs)
+    first = IoStates(tuple(i == 0 for i in range(18)), tuple(i == 1 for i in range(18)), ((1, 1.9), (0, 0.004)),
+                     ((1, 0.0), (1, 0.5)))
+    msg = kept.update(first)
+    assert [d.pin for d in msg.digital_in_states] == list(range(18)) and msg.flag_states == []
+    assert [d.state for d in msg.digital_in_states] == list(first.digital_in)
+    assert [d.state for d in msg.digital_out_states] == list(first.digital_out)
+    assert [(a.pin, a.domain, a.state) for a in msg.analog_in_states] == [(0, 1, 1.9), (1, 0, 0.004)]
+    later = IoStates(tuple(False for _ in range(18)), first.digital_out, ((1, 1.05), (0, 0.0)), first.analog_out)
+    assert kept.update(later) is msg  # the same message, its values changed
+    assert not any(d.state for d in msg.digital_in_states) and msg.digital_out_states[1].state
+    assert [(a.domain, a.state) for a in msg.analog_in_states] == [(1, 1.05), (0, 0.0)]

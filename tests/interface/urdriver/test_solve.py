@@ -51,6 +51,11 @@ def test_a_three_block_solve_runs_the_plan_in_its_own_time():
     report = st.report()
     assert report["goals"]["succeeded"] == 15 and report["goals"]["max_lateness_s"] <= 0.02
     assert report["final"]["at_home"] and not report["final"]["suction_on"]
+    # The path the client measured, every joint state from the plan's start to its end (125 Hz on lab_sim): well
+    # inside the plan's 2 mm corridor (measured 0.08 mm; the vertical legs 0.05 mm).
+    path = result.path
+    assert path is not None and path.samples == pytest.approx(125 * result.executed_s, abs=2)
+    assert path.max_m < 0.25e-3 and path.vertical_max_m is not None and path.vertical_max_m < 0.1e-3
 
 
 def test_at_half_speed_the_motion_takes_twice_as_long():
@@ -58,6 +63,7 @@ def test_at_half_speed_the_motion_takes_twice_as_long():
     p = plan(1)
     assert slots(st)[1] == (3, 1)
     assert result.executed_s == pytest.approx(2 * p.motion_s + p.dwell_total_s, rel=0.02)
+    assert result.path is not None and result.path.max_m < 0.25e-3
 
 
 def test_a_missing_block_halts_cancel_suction_off_home():
@@ -85,6 +91,24 @@ class HoldingTransport(LoopbackTransport):
         if self.cycles == 60:
             self.station.on_hold(3.0)
         super().wait(timeout_s)
+
+
+class HoldInCarry(LoopbackTransport):
+    """Holds the arm for 0.1 s, 100 control cycles into the second goal (the carry of move 1): someone touching it.
+    The controller's path tolerance (0.2 rad) lets it go on; the robot catches up on a short cut."""
+
+    def wait(self, timeout_s: float) -> None:
+        if self._sent == 2:
+            self.in_carry = getattr(self, "in_carry", 0) + 1
+            if self.in_carry == 100:
+                self.station.on_hold(0.1)
+        super().wait(timeout_s)
+
+
+def test_an_arm_held_in_a_carry_leaves_the_corridor_and_the_client_measures_it():
+    result, st, _ = solve(1, HoldInCarry)
+    assert slots(st)[1] == (3, 1) and st.report()["goals"]["aborted"] == 0  # solved all the same
+    assert result.path is not None and result.path.max_m > 5e-3 and result.path.worst_phase == "CARRY"
 
 
 class RenamingTransport(LoopbackTransport):

@@ -25,6 +25,7 @@ from ur3hanoi.interface.urdriver.client import DriverState, GoalResult
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
 from ur3hanoi.interface.urdriver.io import IoStates
+from ur3hanoi.interface.urdriver.joint_record import JointRecord
 
 # actionlib_msgs/GoalStatus values (SimpleActionClient.get_state) and how the solve reads them.
 _STATUS = {3: "succeeded", 4: "aborted", 5: "rejected", 2: "preempted", 8: "canceled", 9: "lost"}
@@ -78,6 +79,7 @@ class RosDriverTransport:
         self._msgs: Any = None
         self._watch: Any = None
         self.names_seen: tuple[str, ...] = ()
+        self.record = JointRecord()
 
     # --------------------------------------------------------------------------------------------- callbacks
     def _update(self, **fields: Any) -> None:
@@ -93,7 +95,9 @@ class RosDriverTransport:
         if all(j in index for j in CONTROLLER_JOINTS) and len(msg.position) == len(msg.name):
             q = np.array([msg.position[index[j]] for j in CONTROLLER_JOINTS], dtype=float)
             if np.all(np.isfinite(q)):
-                self._update(q=q, t_q=time.monotonic())
+                now = time.monotonic()
+                self.record.add(now, q)
+                self._update(q=q, t_q=now)
 
     def _on_io_states(self, msg: Any) -> None:
         io = IoStates(tuple(bool(d.state) for d in msg.digital_in_states),

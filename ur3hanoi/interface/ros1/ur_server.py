@@ -34,7 +34,7 @@ from ur3hanoi.interface.ros1.server import RosServer, RosServerOptions
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1, ROS1_JOINT_STATE_ORDER
 from ur3hanoi.interface.urdriver.follower import Feedback, Outcome
 from ur3hanoi.interface.urdriver.goal import JointTolerance, Rejection, TrajectoryGoal, TrajectoryPoint
-from ur3hanoi.interface.urdriver.io import IoStates
+from ur3hanoi.interface.urdriver.io import IoStatesMessage
 from ur3hanoi.interface.urdriver.station import DriverStation, DriverStationOptions
 
 HOLD_TOPIC = "/ur3hanoi/hold_arm"
@@ -144,6 +144,7 @@ class RosDriverServer(RosServer, DriverStation):
         program.publish(std_msgs.Bool(True))
         order = np.array([CONTROLLER_JOINTS.index(n) for n in ROS1_JOINT_STATE_ORDER])
         unit = self.options.profile.speed_scaling_unit
+        io_msg = IoStatesMessage(m)
 
         def publish() -> None:
             out = self.output
@@ -151,7 +152,7 @@ class RosDriverServer(RosServer, DriverStation):
                                         velocity=out.qd[order].tolist(), effort=out.effort[order].tolist())
             js.header.stamp = rospy.Time.now()
             pubs[0].publish(js)
-            pubs[1].publish(self._io_msg(m, out.io))
+            pubs[1].publish(io_msg.update(out.io))
             pubs[2].publish(std_msgs.Float64(out.speed_scaling * unit))
             if self.follower.running != running[0]:
                 running[0] = self.follower.running
@@ -159,16 +160,6 @@ class RosDriverServer(RosServer, DriverStation):
             self._goal_events(m, out.decisions, out.feedback, out.results, rospy.Time.now())
 
         return publish
-
-    @staticmethod
-    def _io_msg(m: DriverMessages, io: IoStates) -> Any:
-        return m.IOStates(digital_in_states=[m.Digital(pin=i, state=s) for i, s in enumerate(io.digital_in)],
-                          digital_out_states=[m.Digital(pin=i, state=s) for i, s in enumerate(io.digital_out)],
-                          flag_states=[],
-                          analog_in_states=[m.Analog(pin=i, domain=d, state=v)
-                                            for i, (d, v) in enumerate(io.analog_in)],
-                          analog_out_states=[m.Analog(pin=i, domain=d, state=v)
-                                             for i, (d, v) in enumerate(io.analog_out)])
 
     def _goal_events(self, m: DriverMessages, decisions: tuple[tuple[Any, Rejection | None], ...],
                      feedback: tuple[Any, Feedback] | None, results: tuple[tuple[Any, Outcome], ...],

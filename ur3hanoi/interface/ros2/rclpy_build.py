@@ -7,14 +7,15 @@ Where no ROS 2 installation fits the project's Python, third-party repackaged RO
 in with ``LD_LIBRARY_PATH`` set, so they go into a virtual environment of their own, never the project's.
 
 ``control_msgs`` and ``ur_msgs`` are not on PyPI: they are built here from their official texts (vendored in
-:mod:`ur3hanoi.interface.ros2.idl`, provenance in its README) with the rosidl generators of the same wheels and plain
-cmake + make, each message package into a prefix of its own. ``control_msgs``'s FollowJointTrajectory has two
-layouts: Humble (4.x) and Jazzy (5.x) share one, Kilted and later (>= 6.3.0) add ``index`` fields to the feedback,
-so the Jazzy wheels get the first and the Kilted wheels the second: a robot on Humble or Jazzy needs
-``--distro jazzy`` (the default), one on Kilted or Lyrical ``--distro kilted``.
+:data:`ur3hanoi.interface.urdriver.facts.MSG_TEXTS`, provenance in its README; ROS 1 reads the same ``ur_msgs``) with
+the rosidl generators of the same wheels and plain cmake + make, each message package into a prefix of its own.
+``control_msgs``'s FollowJointTrajectory has two layouts: Humble (4.x) and Jazzy (5.x) share one, Kilted and later
+(>= 6.3.0) add ``index`` fields to the feedback, so the Jazzy wheels get the first and the Kilted wheels the second: a
+robot on Humble or Jazzy needs ``--distro jazzy`` (the default), one on Kilted or Lyrical ``--distro kilted``.
 
-One environment per (wheels, Python, pins and texts): ``<cache>/ros2-<wheels>-py<X.Y>-<key>``, where the key hashes
-the pinned packages and every message text, so a change is a new folder, never a stale one. ``manifest.json``,
+One environment per (wheels, Python, pins): ``<cache>/ros2-<wheels>-py<X.Y>-<key>``, where the key hashes the pinned
+packages, so other pins are a new folder, never a stale one; in it, a message package is built again whenever its
+own key changes (:func:`package_key`: its texts, dependencies and build files). ``manifest.json``,
 written last, marks it complete and lists what a process needs (:mod:`ur3hanoi.interface.ros2.rclpy_env` reads
 it). A build holds a lock; a folder left without a manifest by a killed build is removed and built again.
 """
@@ -31,11 +32,11 @@ import subprocess
 import sys
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
-from importlib.resources import files
 from pathlib import Path
 
 from ur3hanoi.interface.ros2.errors import RclpyUnavailableError
 from ur3hanoi.interface.ros2.rclpy_env import RclpyEnv, read_manifest, write_manifest
+from ur3hanoi.interface.urdriver.facts import msg_text
 
 _BUILD_TOOLS = ("catkin-pkg==1.1.1", "PyYAML==6.0.4")
 
@@ -47,7 +48,7 @@ class Wheels:
 
     distro: str
     packages: tuple[str, ...]
-    fjt_layout: str  # the folder of idl/control_msgs/action/ with this distro group's FollowJointTrajectory
+    fjt_layout: str  # the suffix of this distro group's FollowJointTrajectory-<layout>.action in MSG_TEXTS
 
 
 WHEELS: dict[str, Wheels] = {
@@ -79,20 +80,16 @@ class MsgPackage:
     dependencies: tuple[str, ...]
 
 
-def _idl_text(*parts: str) -> str:
-    return files("ur3hanoi.interface.ros2").joinpath("idl", *parts).read_text(encoding="utf-8")
-
-
 def driver_packages(wheels: Wheels) -> tuple[MsgPackage, ...]:
     """``control_msgs`` (FollowJointTrajectory and its tolerances, in ``wheels``' layout) and ``ur_msgs`` (SetIO,
-    IOStates), as vendored."""
+    IOStates), as vendored, each file named as the package has it."""
     control = MsgPackage("control_msgs", {
-        "action/FollowJointTrajectory.action": _idl_text("control_msgs", "action", wheels.fjt_layout,
-                                                         "FollowJointTrajectory.action"),
-        "msg/JointTolerance.msg": _idl_text("control_msgs", "msg", "JointTolerance.msg"),
-        "msg/JointComponentTolerance.msg": _idl_text("control_msgs", "msg", "JointComponentTolerance.msg"),
+        "action/FollowJointTrajectory.action": msg_text("control_msgs",
+                                                        f"FollowJointTrajectory-{wheels.fjt_layout}.action"),
+        "msg/JointTolerance.msg": msg_text("control_msgs", "JointTolerance.msg"),
+        "msg/JointComponentTolerance.msg": msg_text("control_msgs", "JointComponentTolerance.msg"),
     }, ("action_msgs", "builtin_interfaces", "geometry_msgs", "std_msgs", "trajectory_msgs"))
-    ur = MsgPackage("ur_msgs", {f"{kind}/{name}": _idl_text("ur_msgs", kind, name) for kind, name in (
+    ur = MsgPackage("ur_msgs", {f"{kind}/{name}": msg_text("ur_msgs", name) for kind, name in (
         ("msg", "Analog.msg"), ("msg", "Digital.msg"), ("msg", "IOStates.msg"), ("srv", "SetIO.srv"))}, ())
     return control, ur
 
@@ -117,8 +114,9 @@ def env_root(cache: Path, wheels: Wheels, version: str) -> Path:
 
 
 def package_key(package: MsgPackage) -> str:
-    """A hash of a message package's texts and dependencies: another text is another build."""
-    return _digest([package.name, sorted(package.texts.items()), package.dependencies])
+    """A hash of what builds a message package (its texts, dependencies and the build files made from them):
+    another text, or another ``CMakeLists.txt`` or ``package.xml``, is another build."""
+    return _digest([package.name, sorted(package.texts.items()), package.dependencies, _CMAKELISTS, _PACKAGE_XML])
 
 
 _CMAKELISTS = """cmake_minimum_required(VERSION 3.8)

@@ -29,6 +29,7 @@ from ur3hanoi.interface.ros2.rclpy_env import import_interfaces, import_rclpy
 from ur3hanoi.interface.ros2.ur_driver import goal_to_msg, io_from_msg, joint_positions, names_for
 from ur3hanoi.interface.urdriver.client import DriverState, GoalResult
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
+from ur3hanoi.interface.urdriver.joint_record import JointRecord
 
 CONNECT_TIMEOUT_S = 10.0
 """How long :meth:`RclpyDriverTransport.connect` waits for the driver [s]."""
@@ -103,6 +104,7 @@ class RclpyDriverTransport:
         self._lock = threading.Lock()
         self._state = DriverState()
         self._started = False
+        self.record = JointRecord()
 
     def now(self) -> float:
         return time.monotonic()
@@ -170,9 +172,11 @@ class RclpyDriverTransport:
     def _on_joints(self, msg: Any) -> None:
         q = joint_positions(msg.name, msg.position)
         if q is not None:
+            now = time.monotonic()
+            self.record.add(now, q)
             with self._lock:
                 s = self._state
-                self._state = DriverState(q, time.monotonic(), s.io, s.speed_scaling)
+                self._state = DriverState(q, now, s.io, s.speed_scaling)
             self._wake.set()
 
     def _on_io(self, msg: Any) -> None:

@@ -122,34 +122,6 @@ def set_duration(d: Any, seconds: float) -> Any:
     return d
 
 
-class IoStatesMessage:
-    """One ``ur_msgs/IOStates`` message kept across cycles (``msgs`` = the ``ur_msgs.msg`` module): 18 digital in and
-    out, 2 analog in and out, no flags, ``pin`` = index, as the driver publishes. :meth:`update` writes only the
-    values that changed: building 40 nested messages every cycle costs a 500 Hz loop a tenth of its period."""
-
-    def __init__(self, msgs: Any) -> None:
-        self.msg = msgs.IOStates(
-            digital_in_states=[msgs.Digital(pin=i, state=False) for i in range(18)],
-            digital_out_states=[msgs.Digital(pin=i, state=False) for i in range(18)], flag_states=[],
-            analog_in_states=[msgs.Analog(pin=i, domain=1, state=0.0) for i in range(2)],
-            analog_out_states=[msgs.Analog(pin=i, domain=1, state=0.0) for i in range(2)])
-        self._last: IoStates | None = None
-
-    def update(self, io: IoStates) -> Any:
-        """The message holding ``io``."""
-        last, m = self._last, self.msg
-        for field, items, values in (("digital_in", m.digital_in_states, io.digital_in),
-                                     ("digital_out", m.digital_out_states, io.digital_out)):
-            if last is None or getattr(last, field) != values:
-                for item, on in zip(items, values, strict=True):
-                    item.state = bool(on)
-        for items, analog in ((m.analog_in_states, io.analog_in), (m.analog_out_states, io.analog_out)):
-            for item, (domain, value) in zip(items, analog, strict=True):
-                item.domain, item.state = domain, float(value)
-        self._last = io
-        return m
-
-
 def goal_to_msg(goal: TrajectoryGoal, action: Any, trajectory_msgs: Any) -> Any:
     """The neutral goal as a ``FollowJointTrajectory.Goal`` (``action`` = the action class; zero ``header.stamp``:
     start now)."""

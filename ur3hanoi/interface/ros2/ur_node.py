@@ -10,6 +10,7 @@ feedback's ``index``), else one line says which and how to get the other.
 from __future__ import annotations
 
 import contextlib
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -18,8 +19,9 @@ from typing import Any, Protocol
 from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 from ur3hanoi.interface.ros2.errors import RclpyUnavailableError
 from ur3hanoi.interface.ros2.rclpy_env import import_interfaces, import_rclpy
-from ur3hanoi.interface.ros2.ur_driver import FEEDBACK_HZ, SPEED_SCALING_HZ, IoStatesMessage, set_duration
+from ur3hanoi.interface.ros2.ur_driver import FEEDBACK_HZ, SPEED_SCALING_HZ, set_duration
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1_JOINT_STATE_ORDER, DriverNames
+from ur3hanoi.interface.urdriver.io import IoStatesMessage
 from ur3hanoi.interface.urdriver.station import CycleOutput, DriverStationOptions
 
 
@@ -50,6 +52,12 @@ JOINT_STATE_ORDER = ROS1_JOINT_STATE_ORDER
 by position, as a real robot may."""
 _THREADS = 8
 """Executor threads: every running goal's execute callback and a ``set_io`` call wait in one."""
+PUBLICATION_MODE = ("RMW_FASTRTPS_PUBLICATION_MODE", "ASYNCHRONOUS")
+"""Fast DDS sends the station's samples from a thread of its own: publishing never waits for a client that reads or
+acknowledges late (rclpy holds the GIL while a synchronous write waits: a slow reader of the 500 Hz joint states
+stalled the control loop for milliseconds a cycle, bench/bench_driver.py), as the real driver's controllers never
+wait for theirs (ros2_control publishes through realtime_tools' RealtimePublisher, from its own thread). The wire,
+the QoS and the order per topic are the same; a value the user set is kept; other RMWs ignore it."""
 
 
 def check_layout(action: Any, distro: str) -> None:
@@ -76,6 +84,7 @@ class DriverNode:
         check_layout(action, distro)
         self.station, self.rclpy, self.action, self.ur_msg = station, rclpy, action, ur_msg
         self.sensor_msgs, self.std_msgs = sensor_msgs, std_msgs
+        os.environ.setdefault(*PUBLICATION_MODE)  # read when the context's participant is made
         self.context = rclpy.Context()
         kwargs = {} if domain_id is None else {"domain_id": domain_id}
         from rclpy.signals import SignalHandlerOptions

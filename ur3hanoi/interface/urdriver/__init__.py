@@ -2,7 +2,8 @@
 
 Modules, one concept each (importing this package needs neither ROS nor MuJoCo):
 
-- :mod:`~ur3hanoi.interface.urdriver.facts`: names, error codes, the IO pin mapping.
+- :mod:`~ur3hanoi.interface.urdriver.facts`: names, error codes, the IO pin mapping, the official message texts
+  (the data folder ``msg_texts/``, read by both bindings).
 - :mod:`~ur3hanoi.interface.urdriver.profile`: the controllers' defaults and the ROS 1 / ROS 2 differences.
 - :mod:`~ur3hanoi.interface.urdriver.spline`: the joint trajectory controller's linear, cubic and quintic segments.
 - :mod:`~ur3hanoi.interface.urdriver.goal`: a ``FollowJointTrajectory`` goal and the checks before it is accepted.
@@ -13,6 +14,8 @@ Modules, one concept each (importing this package needs neither ROS nor MuJoCo):
 - :mod:`~ur3hanoi.interface.urdriver.client`: what a client's binding provides (``DriverTransport``).
 - :mod:`~ur3hanoi.interface.urdriver.station`: the station without its transport (``DriverStation``).
 - :mod:`~ur3hanoi.interface.urdriver.solve`: the plan on the driver with the lab's checks (``run_driver_solve``).
+- :mod:`~ur3hanoi.interface.urdriver.joint_record`: the joint states a client received, in bounded memory.
+- :mod:`~ur3hanoi.interface.urdriver.path_deviation`: how closely the executed suction point followed the plan.
 - :mod:`~ur3hanoi.interface.urdriver.loopback`: client and station in one process on the CPU clock.
 
 Bindings: :mod:`ur3hanoi.interface.ros1` (``ur_server``, ``ur_client``) and :mod:`ur3hanoi.interface.ros2`.

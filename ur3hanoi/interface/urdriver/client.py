@@ -3,7 +3,8 @@
 A binding (ROS 1: :class:`ur3hanoi.interface.ros1.ur_client.RosDriverTransport`; ROS 2: the rclpy one) connects to
 the driver, keeps the latest joint states (by joint name, into
 :data:`~ur3hanoi.interface.urdriver.facts.CONTROLLER_JOINTS` order), ``io_states`` and speed scaling (as a fraction),
-sends ``FollowJointTrajectory`` goals and calls ``set_io``.
+sends ``FollowJointTrajectory`` goals and calls ``set_io``; it adds every joint state to its
+:class:`~ur3hanoi.interface.urdriver.joint_record.JointRecord`.
 Everything else -- the plan as goals, the suction checks, halts, timeouts and errors -- is the middleware-neutral
 solve (:func:`ur3hanoi.interface.urdriver.solve.run_driver_solve`), the same on ROS 1 and ROS 2.
 """
@@ -18,6 +19,7 @@ from ur3hanoi.errors import DriverError
 from ur3hanoi.interface.urdriver.facts import code_name
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
 from ur3hanoi.interface.urdriver.io import IoStates
+from ur3hanoi.interface.urdriver.joint_record import JointRecord
 
 GoalStatus = Literal["succeeded", "aborted", "rejected", "canceled", "preempted", "lost"]
 
@@ -73,6 +75,9 @@ class DriverTransport(Protocol):
 
     where: str
     """Where the driver is, for messages (the ROS master URI, the ROS 2 domain)."""
+    record: JointRecord
+    """Every joint state received (with :meth:`now` at its arrival) while the solve records: the transport adds each
+    message, the solve starts and stops it (and measures the path from it afterwards)."""
 
     def connect(self) -> None:
         """Wait for the driver's joint states, ``io_states``, action server and ``set_io`` service.

@@ -8,12 +8,15 @@
 - IO: the ``ur_msgs/SetIO`` functions, the pin mapping of ``FUN_SET_DIGITAL_OUT`` (0-7 standard, 8-15 configurable,
   16-17 tool outputs) and the ``io_states`` layout (18 digital in/out, 2 analog in/out, ``pin`` = index).
 - :data:`ROS1`: the ROS 1 driver's topic, service and action names (``ur_robot_driver``'s defaults).
+- :data:`MSG_TEXTS`: the official ``control_msgs`` and ``ur_msgs`` texts, vendored once for both bindings
+  (:func:`msg_text`; provenance, git blob ids and which ROS reads which file in ``msg_texts/README.md``).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import IntEnum
+from pathlib import Path
 
 from ur3hanoi.robot.urdf import JOINT_NAMES
 
@@ -84,3 +87,17 @@ ROS1 = DriverNames(
     speed_scaling="/speed_scaling_factor",
 )
 """The ROS 1 ``ur_robot_driver`` (``ur3_bringup.launch``): ``speed_scaling`` is a ``std_msgs/Float64`` fraction."""
+
+
+# -------------------------------------------------------------------------------------------- message texts
+MSG_TEXTS = Path(__file__).resolve().parent / "msg_texts"
+"""The official message texts, byte for byte as upstream has them, one file per distinct text: ``control_msgs/`` and
+``ur_msgs/``. A suffix names a version-specific text (``-ros1``: ROS 1 Noetic; ``-jazzy``, ``-kilted``: the two ROS 2
+layouts of ``FollowJointTrajectory``; ``-1.3``: ur_msgs 1.3.x); no suffix: the text ROS 1 and ROS 2 share, or ROS 2's.
+The ROS 1 binding generates its classes from them with genpy (:mod:`ur3hanoi.interface.ros1.driver_msgs`), the
+ROS 2 environment builds them with rosidl (:mod:`ur3hanoi.interface.ros2.rclpy_build`)."""
+
+
+def msg_text(package: str, file: str) -> str:
+    """The vendored text of ``package/file`` (``msg_text("ur_msgs", "SetIO-1.3.srv")``)."""
+    return (MSG_TEXTS / package / file).read_text(encoding="utf-8")

@@ -82,6 +82,12 @@ class _Tolerances:
     goal: FloatArray
     goal_v: FloatArray
     goal_time_s: float
+    bounds: tuple[FloatArray, ...] = ()  # path, path_v, goal, goal_v as bounds on |error| (inf: not checked)
+
+    def seal(self) -> _Tolerances:
+        """Fix :attr:`bounds` from the tolerances (once they are final): checked every cycle, so computed once."""
+        self.bounds = tuple(np.where(x > 0.0, x, np.inf) for x in (self.path, self.path_v, self.goal, self.goal_v))
+        return self
 
 
 @dataclass
@@ -146,7 +152,7 @@ class TrajectoryFollower:
                     i = index[t.name]
                     q_tol[i], v_tol[i] = _override(t.position, q_tol[i]), _override(t.velocity, v_tol[i])
         tol.goal_time_s = _override(goal.goal_time_tolerance_s, tol.goal_time_s)
-        return tol
+        return tol.seal()
 
     @staticmethod
     def _point(p: TrajectoryPoint, order: list[int]) -> JointState:
@@ -256,8 +262,8 @@ class TrajectoryFollower:
     def _check(self, active: _Active, seg: Segment, last: bool, err_q: FloatArray, err_qd: FloatArray) -> None:
         tol, prof = active.tolerances, self.profile
         if self.uptime < seg.end_s - TIME_RESOLUTION_S:
-            active.max_path_error = max(active.max_path_error, float(np.max(np.abs(err_q))))
-            bad = _outside(err_q, err_qd, tol.path, tol.path_v)
+            active.max_path_error = max(active.max_path_error, float(np.abs(err_q).max()))
+            bad = _outside(err_q, err_qd, tol.bounds[0], tol.bounds[1])
             if bad is not None:
                 self._end("aborted", ErrorCode.PATH_TOLERANCE_VIOLATED,
                           prof.path_error.format(joint=self.joints[bad], error=float(err_q[bad]), late=0.0))
@@ -266,7 +272,7 @@ class TrajectoryFollower:
             return
         if not last:
             return
-        inside = _inside(err_q, err_qd, tol.goal, tol.goal_v)
+        inside = _inside(err_q, err_qd, tol.bounds[2], tol.bounds[3])
         late = self.uptime - seg.end_s
         out_of_time = (not (prof.goal_time_zero_waits and tol.goal_time_s == 0.0)
                        and late >= tol.goal_time_s - TIME_RESOLUTION_S)
@@ -322,15 +328,15 @@ def stop_ramp(q: FloatArray, qd: FloatArray, t0: float, duration_s: float, a_max
     return ramp
 
 
-def _outside(err_q: FloatArray, err_qd: FloatArray, tol_q: FloatArray, tol_qd: FloatArray) -> int | None:
-    """The first joint outside its (non-zero) tolerances, or None (``checkStateTolerancePerJoint``)."""
-    bad = ((tol_q > 0.0) & (np.abs(err_q) > tol_q)) | ((tol_qd > 0.0) & (np.abs(err_qd) > tol_qd))
-    hits = np.flatnonzero(bad)
-    return int(hits[0]) if hits.size else None
+def _outside(err_q: FloatArray, err_qd: FloatArray, bound_q: FloatArray, bound_qd: FloatArray) -> int | None:
+    """The first joint outside its tolerances (as :attr:`_Tolerances.bounds`: inf where 0 = not checked), or None
+    (``checkStateTolerancePerJoint``)."""
+    bad = (np.abs(err_q) > bound_q) | (np.abs(err_qd) > bound_qd)
+    return int(bad.argmax()) if bad.any() else None
 
 
-def _inside(err_q: FloatArray, err_qd: FloatArray, tol_q: FloatArray, tol_qd: FloatArray) -> BoolArray:
-    return ~(((tol_q > 0.0) & (np.abs(err_q) > tol_q)) | ((tol_qd > 0.0) & (np.abs(err_qd) > tol_qd)))
+def _inside(err_q: FloatArray, err_qd: FloatArray, bound_q: FloatArray, bound_qd: FloatArray) -> BoolArray:
+    return ~((np.abs(err_q) > bound_q) | (np.abs(err_qd) > bound_qd))
 
 
 __all__ = ["Feedback", "Outcome", "TrajectoryFollower", "shortest_angle", "stop_ramp"]

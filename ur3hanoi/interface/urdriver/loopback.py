@@ -14,6 +14,7 @@ from collections.abc import Hashable
 
 from ur3hanoi.interface.urdriver.client import DriverState, GoalResult
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
+from ur3hanoi.interface.urdriver.joint_record import JointRecord
 from ur3hanoi.interface.urdriver.station import DriverStation
 
 
@@ -44,6 +45,7 @@ class LoopbackTransport:
         self.goals: dict[Hashable, LoopbackGoal] = {}
         self._sent = 0
         self.cycles = 0
+        self.record = JointRecord()
 
     def connect(self) -> None:
         self.wait(0.0)
@@ -70,6 +72,7 @@ class LoopbackTransport:
         self.station.cycle()
         self.cycles += 1
         out = self.station.output
+        self.record.add(out.t_s, out.q)
         for key, rejection in out.decisions:
             if rejection is not None and key in self.goals:
                 self.goals.pop(key).outcome = GoalResult("rejected", int(rejection.code), rejection.error_string)

@@ -21,6 +21,11 @@
    :class:`~ur3hanoi.interface.urdriver.client.DriverGoalError` (exit 2) with the driver's code and error string; a
    goal past its timeout: canceled, suction off,
    :class:`~ur3hanoi.errors.DriverError`; joint states that stop: the same.
+6. **The path.** Every joint state received from the plan's start to its end is recorded by the transport
+   (:class:`~ur3hanoi.interface.urdriver.joint_record.JointRecord`); after a solve, the largest distance of the
+   executed suction point from the plan's path (each joint state against its goal's stretch), overall and on the
+   vertical legs
+   (:func:`~ur3hanoi.interface.urdriver.path_deviation.path_deviation`), is in the result.
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ from ur3hanoi.hanoi import Move, block_colour
 from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverTransport, GoalHandle
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, FUN_SET_DIGITAL_OUT
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
+from ur3hanoi.interface.urdriver.path_deviation import PathDeviation, path_deviation, stretch_windows
 from ur3hanoi.interface.urdriver.plan_goals import Stretch, move_goal, plan_stretches
 from ur3hanoi.plan import Plan
 from ur3hanoi.station.suction_wiring import SuctionWiring
@@ -61,7 +67,8 @@ class DriverSolveConfig:
 @dataclass(frozen=True)
 class DriverSolveResult:
     """A completed solve: the moves, the goals sent, the wall times [s] of the whole, of the approach to the plan's
-    start and of the plan's execution (to compare with the plan's own cycle time [s])."""
+    start and of the plan's execution (to compare with the plan's own cycle time [s]), and how closely the executed
+    suction point followed the plan's path (None: no joint state was recorded)."""
 
     moves: tuple[Move, ...]
     goals: int
@@ -69,6 +76,7 @@ class DriverSolveResult:
     approach_s: float
     executed_s: float
     plan_duration_s: float
+    path: PathDeviation | None = None
 
 
 class _HaltError(Exception):
@@ -244,8 +252,10 @@ def run_driver_solve(transport: DriverTransport, plan: Plan, wiring: SuctionWiri
     approach = run.start()
     t_plan = transport.now()
     move = -1
+    transport.record.start()
     try:
-        for s in stretches:
+        for i, s in enumerate(stretches):
+            transport.record.label = i
             move = s.move if s.move >= 0 else move
             if s.goal is None:
                 run.dwell(s)
@@ -254,6 +264,11 @@ def run_driver_solve(transport: DriverTransport, plan: Plan, wiring: SuctionWiri
                 (f" of move {s.move + 1}" if s.move >= 0 else "")
             run.run_goal(s.goal, what, s.carrying)
     except _HaltError as halt:
+        transport.record.stop()
         raise run.halt(halt.kind, move) from None
+    finally:
+        transport.record.stop()
     now = transport.now()
-    return DriverSolveResult(plan.moves, run.goals, now - t0, approach, now - t_plan, plan.duration_s)
+    t, q, stretch = transport.record.samples()
+    path = path_deviation(plan, t, q, stretch_windows(plan, stretches)[stretch]) if len(q) else None
+    return DriverSolveResult(plan.moves, run.goals, now - t0, approach, now - t_plan, plan.duration_s, path)

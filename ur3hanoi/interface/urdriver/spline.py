@@ -23,6 +23,9 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 
+_D1 = np.array([1.0, 2.0, 3.0, 4.0, 5.0])  # d/dt of t^k: k t^(k-1), k = 1..5
+_D2 = np.array([2.0, 6.0, 12.0, 20.0])  # d2/dt2 of t^k: k (k-1) t^(k-2), k = 2..5
+
 
 class JointState(NamedTuple):
     """One state of every joint: positions [rad], velocities [rad/s], accelerations [rad/s^2], each (n,); a field
@@ -65,8 +68,8 @@ class Segment:
             return p, z, z.copy()
         powers = np.array([1.0, t, t * t, t ** 3, t ** 4, t ** 5])
         p = c @ powers
-        v = c[:, 1:] @ (np.array([1.0, 2.0, 3.0, 4.0, 5.0]) * powers[:5])
-        a = c[:, 2:] @ (np.array([2.0, 6.0, 12.0, 20.0]) * powers[:4])
+        v = c[:, 1:] @ (_D1 * powers[:5])
+        a = c[:, 2:] @ (_D2 * powers[:4])
         return p, v, a
 
 

@@ -24,8 +24,6 @@ from collections.abc import Hashable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
-import numpy as np
-
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.interface.server import ServerCore, ServerOptions
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS
@@ -191,7 +189,7 @@ class DriverStation(ServerCore["ServoWorld"]):
                 feedback: tuple[Hashable, Feedback] | None,
                 results: tuple[tuple[Hashable, Outcome], ...]) -> CycleOutput:
         w = self.world
-        effort = np.array(w.scene.data.actuator_force[self._effort_ids], dtype=float)
+        effort = w.scene.data.actuator_force[self._effort_ids]  # a copy (fancy indexing)
         return CycleOutput(w.time, CONTROLLER_JOINTS, w.q, w.qd, effort, self.io.states, w.speed_scaling, decisions,
                            feedback, results)
 
