@@ -11,10 +11,15 @@ from pathlib import Path
 
 import pytest
 
+from tests.support import reaper
 from ur3hanoi.errors import SimulationError
 from ur3hanoi.io.resources import stations_dir
 from ur3hanoi.opengl import use_platform
 from ur3hanoi.station.calibration import Station, load_station
+
+# The stations and clients the tests start are killed when this pytest process is gone, even by SIGKILL
+# (tests/support/reaper.py).
+reaper.start(os.getpid())
 
 # Offscreen rendering with the OpenGL platform the commands would choose on this machine (the display's, else EGL,
 # else OSMesa; a MUJOCO_GL set by the caller is kept). MuJoCo reads MUJOCO_GL when first imported, i.e. while the

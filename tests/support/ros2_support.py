@@ -8,6 +8,7 @@ cannot be made (no ``unshare``, or not permitted).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import signal
@@ -59,4 +60,7 @@ def in_netns(script: str, timeout: float, cwd: Path) -> subprocess.CompletedProc
         os.killpg(proc.pid, signal.SIGKILL)
         out, err = proc.communicate()
         raise AssertionError(f"netns script did not finish within {timeout} s:\n{out}\n{err}") from None
+    finally:  # a station the script or client left in the background does not go on taking a core
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
     return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)

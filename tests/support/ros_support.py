@@ -8,6 +8,7 @@ missing, except under CI (CI installs them with tools/ensure-system-deps.sh, so 
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
@@ -167,6 +168,9 @@ def run(cmd: list[str], env: dict[str, str], timeout: float, stdin: str | None =
         os.killpg(proc.pid, signal.SIGKILL)
         out, err = proc.communicate()
         raise AssertionError(f"{cmd} did not finish within {timeout} s:\n{out}\n{err}") from None
+    finally:  # a station the script or client left in the background does not go on taking a core
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
     return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
 
 

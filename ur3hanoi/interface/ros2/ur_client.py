@@ -118,7 +118,7 @@ class RclpyDriverTransport:
             "control_msgs.action", "ur_msgs.srv", "ur_msgs.msg", "sensor_msgs.msg", "std_msgs.msg",
             "trajectory_msgs.msg")
         from rclpy.action import ActionClient
-        from rclpy.executors import MultiThreadedExecutor
+        from rclpy.executors import SingleThreadedExecutor
 
         check_layout(action, self.distro)
         if self.network == "loopback":
@@ -140,7 +140,9 @@ class RclpyDriverTransport:
         self.client = ActionClient(node, action.FollowJointTrajectory, n.follow_joint_trajectory)
         self.set_io_client = node.create_client(ur_srv.SetIO, n.set_io)
         self._set_io_type = ur_srv.SetIO
-        self.executor = MultiThreadedExecutor(num_threads=2, context=self.context)
+        # One thread: no callback here blocks, and the multi-threaded executor's hand-off to a pool cost the io_states
+        # at 500 Hz: a dropped block reached the cancel 15-30 control cycles late, now 1-2 (bench/bench_driver.py).
+        self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(node)
         self.thread = threading.Thread(target=self.executor.spin, name="rclpy-executor", daemon=True)
         self.thread.start()

@@ -39,6 +39,7 @@ import numpy as np
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import DriverError, SuctionFaultError
 from ur3hanoi.hanoi import Move, block_colour
+from ur3hanoi.interface.solve import describe_move
 from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverTransport, GoalHandle
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, FUN_SET_DIGITAL_OUT
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
@@ -185,6 +186,11 @@ class _Solve:
         self.sleep(self.cfg.rest_timeout_s, still)
 
     # ------------------------------------------------------------------------------------------ steps
+    def announce(self, move: int) -> None:
+        """The progress line of ``move`` (0-based), the same as the course interface's solve prints."""
+        moves = self.plan.moves
+        self.say(f"move {move + 1}/{len(moves)}: {describe_move(moves[move])}")
+
     def start(self) -> float:
         """Bring the arm to where the plan starts, or refuse (see the module docstring); returns the wall time."""
         q0, q = self.plan.trajectory.q[0], self.q()
@@ -256,6 +262,8 @@ def run_driver_solve(transport: DriverTransport, plan: Plan, wiring: SuctionWiri
     try:
         for i, s in enumerate(stretches):
             transport.record.label = i
+            if s.move > move:
+                run.announce(s.move)
             move = s.move if s.move >= 0 else move
             if s.goal is None:
                 run.dwell(s)
