@@ -52,13 +52,11 @@ def marked(owner: int) -> list[int]:
 
 
 def alive(pid: int) -> bool:
+    """True while ``pid`` exists and is not a zombie (a dead process its parent has not waited for yet)."""
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
         return False
-    except PermissionError:
-        return True
-    return True
 
 
 def reap(owner: int) -> int:

@@ -199,14 +199,6 @@ def descendants(pid: int) -> set[int]:
     return found
 
 
-def alive(pid: int) -> bool:
-    """True while ``pid`` exists and is not a zombie."""
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return False
-
-
 def listening_addresses(pids: set[int]) -> list[tuple[str, int]]:
     """(address, port) of every listening TCP socket (IPv4 and IPv6) held by ``pids``, from /proc/net/tcp*."""
     inodes: set[str] = set()

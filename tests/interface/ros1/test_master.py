@@ -13,7 +13,8 @@ import time
 
 import pytest
 
-from tests.support.ros_support import alive, free_port, requires_ros, ros_env
+from tests.support.reaper import alive
+from tests.support.ros_support import free_port, requires_ros, ros_env
 from ur3hanoi.interface.ros1.errors import RosError
 from ur3hanoi.interface.ros1.guard import LOG_DIR_PREFIX, remove_stale_log_dirs
 from ur3hanoi.interface.ros1.master import MasterUri, RosCore, listen_env, master_answers, master_pid, probe_master

@@ -18,9 +18,9 @@ from pathlib import Path
 import pytest
 
 from tests.support import SUPPORT
+from tests.support.reaper import alive
 from tests.support.ros_support import (
     Station,
-    alive,
     descendants,
     final_slots,
     free_port,

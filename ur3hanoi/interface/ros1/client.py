@@ -87,22 +87,16 @@ class RosArm(TopicArm):
 
     def close(self) -> None:
         """Stop watching the master and unregister the node (not with a master that is gone)."""
-        from ur3hanoi.interface.ros1.watch import forget_master
+        from ur3hanoi.interface.ros1.watch import end_client
 
         watch, self._watch = self._watch, None
-        if watch is not None:
-            watch.stop()
-            if watch.lost is not None:
-                forget_master()
-        if self._rospy is not None:
-            self._rospy.signal_shutdown("ur3hanoi ros-solve done")
+        end_client(watch, self._rospy)
 
     def _poll(self) -> None:
         """Raise once the master is gone (the callbacks themselves run in rospy's threads)."""
-        lost = None if self._watch is None else self._watch.lost
-        if lost is not None:
-            raise RosError(f"the ROS master at {self.master_uri} is gone ({lost}): ros-solve stops; is the station "
-                           "(or roscore) still running?")
+        from ur3hanoi.interface.ros1.watch import raise_if_lost
+
+        raise_if_lost(self._watch, self.master_uri, "the station (or roscore)")
 
     # ---------------------------------------------------------------------------------------------- transport
     def _subscribed(self) -> bool:

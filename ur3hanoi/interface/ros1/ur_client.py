@@ -162,21 +162,15 @@ class RosDriverTransport:
 
     def close(self) -> None:
         """Stop watching the master and unregister the node (not with a master that is gone)."""
-        from ur3hanoi.interface.ros1.watch import forget_master
+        from ur3hanoi.interface.ros1.watch import end_client
 
         watch, self._watch = self._watch, None
-        if watch is not None:
-            watch.stop()
-            if watch.lost is not None:
-                forget_master()
-        if self._rospy is not None:
-            self._rospy.signal_shutdown("ur3hanoi ros-solve done")
+        end_client(watch, self._rospy)
 
     def _check_master(self) -> None:
-        lost = None if self._watch is None else self._watch.lost
-        if lost is not None:
-            raise RosError(f"the ROS master at {self.master_uri} is gone ({lost}): ros-solve stops; is the driver "
-                           "still running?")
+        from ur3hanoi.interface.ros1.watch import raise_if_lost
+
+        raise_if_lost(self._watch, self.master_uri, "the driver")
 
     # ---------------------------------------------------------------------------------------------- transport
     def now(self) -> float:

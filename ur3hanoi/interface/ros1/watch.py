@@ -153,4 +153,24 @@ def forget_master() -> None:
             reg.master_uri = None
 
 
-__all__ = ["NO_ANSWER_S", "WATCH_PERIOD_S", "MasterWatch", "forget_master", "quick_shutdown", "reregister"]
+def raise_if_lost(watch: MasterWatch | None, uri: str, ask: str) -> None:
+    """A client's check between its steps: :class:`RosError` once ``watch``'s master is gone (``ask``: what the user
+    should look at)."""
+    lost = None if watch is None else watch.lost
+    if lost is not None:
+        raise RosError(f"the ROS master at {uri} is gone ({lost}): ros-solve stops; is {ask} still running?")
+
+
+def end_client(watch: MasterWatch | None, rospy: Any) -> None:
+    """A client's end: stop watching the master and shut the node down (not unregistering with a master that is
+    gone)."""
+    if watch is not None:
+        watch.stop()
+        if watch.lost is not None:
+            forget_master()
+    if rospy is not None:
+        rospy.signal_shutdown("ur3hanoi ros-solve done")
+
+
+__all__ = ["NO_ANSWER_S", "WATCH_PERIOD_S", "MasterWatch", "end_client", "forget_master", "quick_shutdown",
+           "raise_if_lost", "reregister"]
