@@ -110,6 +110,19 @@ class Robot:
         js = self.joint_state
         return {n: p for n, p in zip(js.name, js.position, strict=False)}
 
+    def at_rest(self, timeout):
+        """Spin until the arm has stopped (two positions 0.1 s apart within 1 mrad), at most ``timeout`` [s]; the
+        seconds waited. An abort or a cancel stops the arm within its deceleration limits: from full speed that
+        takes longer than a fixed wait may allow."""
+        t0, last = time.monotonic(), self.position()
+        while time.monotonic() - t0 < timeout:
+            self.spin_until(lambda: False, 0.1)
+            now = self.position()
+            if max(abs(now[j] - last[j]) for j in ROBOT_JOINTS) < 1e-3:
+                break
+            last = now
+        return time.monotonic() - t0
+
 
 def main():
     home = json.loads(sys.argv[1])
@@ -170,7 +183,7 @@ def main():
     # test_trajectory_scaled_aborts_on_violation: a jump the joints cannot follow
     gh = robot.send(robot.trajectory([offset(-0.2), offset(-1.0)], [1.0, 1.05]))
     out["violation"] = robot.result(gh)
-    robot.spin_until(lambda: False, 0.3)
+    out["stop_after_abort_s"] = robot.at_rest(3.0)
     aborted_at = robot.position()
     robot.spin_until(lambda: False, 1.0)
     after = robot.position()
