@@ -44,6 +44,25 @@ LAB_REAL = stations_dir() / "lab_real.yaml"
 STATION_FILES = {"lab_sim": LAB_SIM, "lab_real": LAB_REAL}
 
 
+SHARED_SCOPES = ("module", "package", "class")
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Under ``--dist loadgroup`` (make test's wall-clock phase) the tests of one module that share a module-scoped
+    fixture (a station, a built wheel, a ROS 2 environment's graph) go to one worker, so that it starts once; one
+    group per value of a parametrised one (Jazzy and Kilted may run side by side). Other tests go one by one."""
+    for item in items:
+        info = getattr(item, "_fixtureinfo", None)
+        if info is None or item.get_closest_marker("xdist_group") is not None:
+            continue
+        shared = sorted(name for name, defs in info.name2fixturedefs.items() if defs[-1].scope in SHARED_SCOPES)
+        if shared:
+            params = getattr(getattr(item, "callspec", None), "params", {})
+            values = [f"{name}={params[name]}" for name in shared if name in params]
+            item.add_marker(pytest.mark.xdist_group("|".join([item.module.__name__, *values])))
+
+
 @pytest.fixture(scope="session")
 def repo() -> Path:
     return REPO

@@ -221,9 +221,9 @@ $UR3HANOI ros2-station --timing honest --report {report} > {tmp_path}/st.out 2> 
 ST=$!
 wait_ready {tmp_path}/st.out || exit 90
 {PUBLISHER} '{json.dumps(bad)}' || exit 91
-kill -USR1 $ST; sleep 0.5; cp {report} {tmp_path}/snap.json
+snapshot $ST {report} {tmp_path}/snap.json || exit 93
 {PUBLISHER} '{json.dumps(good)}' || exit 92
-sleep 1.5
+report_until $ST {report} {tmp_path}/last.json 'r["commands"]["executed"] == 1 and r["final"]["ready"]' || exit 94
 kill -TERM $ST; wait $ST; echo "station exit $?" >&2
 """
     result = in_netns(script, 120.0, REPO)
@@ -235,7 +235,8 @@ kill -TERM $ST; wait $ST; echo "station exit $?" >&2
     assert len(reasons) == 5 and all(x.startswith(p) for x, p in zip(reasons, HONEST_REFUSALS, strict=True)), reasons
     assert snap["executed"] == [] and snap["commands"]["rejected"] == 5
     assert max(abs(a - b) for a, b in zip(snap["final"]["q"], load_station("ur3e_sim").q_home, strict=True)) < 1e-6
-    assert r["commands"]["executed"] == 1 and r["reports_written"] == snap["reports_written"] + 1
+    last = json.loads((tmp_path / "last.json").read_text())  # the last SIGUSR1 report, once the move was over
+    assert r["commands"]["executed"] == 1 and r["reports_written"] == last["reports_written"] + 1
     assert max(abs(a - b - o) for a, b, o in zip(r["final"]["q"], near, COURSE_OFFSET, strict=True)) < 5e-4
     lines = _log_lines(err)
     assert lines[0] == f"[ERROR] ur3e/command dropped, the arm does not move: {reasons[0]}"
@@ -307,7 +308,7 @@ ST=$!
 wait_ready {tmp_path}/st.out || exit 90
 {PUBLISHER} --int ur3hanoi/remove_block 0 1 || exit 91
 {solve} > {tmp_path}/halt.json; echo "halt exit $?" >&2
-kill -USR1 $ST; sleep 0.5; cp {report} {tmp_path}/snap.json
+snapshot $ST {report} {tmp_path}/snap.json || exit 93
 {PUBLISHER} --int ur3hanoi/spawn 7 1 || exit 92
 {solve} > {tmp_path}/solve.json; echo "solve exit $?" >&2
 kill -INT $ST; wait $ST; echo "station exit $?" >&2
