@@ -7,7 +7,7 @@ VENV ?= .venv
 STAMP := $(VENV)/.installed
 export NO_MKDOCS_2_WARNING ?= 1  # Material's end-of-life notice on every docs build
 
-.PHONY: solve test test-fast venv lint bench tables docs pictures clean lab
+.PHONY: solve test test-all test-fast venv lint bench tables docs pictures clean lab
 
 # ur3hanoi/version.py: the installed metadata's version is read from it (pyproject.toml's dynamic version).
 $(STAMP): pyproject.toml requirements.lock tools/ensure-system-deps.sh ur3hanoi/version.py
@@ -31,13 +31,18 @@ solve: $(STAMP)
 REALTIME := ros or dds or rclpy or packaging
 WALL_WORKERS ?= 4
 timed = start=$$(date +%s); $(2); code=$$?; echo "make $@: $(1) phase took $$(($$(date +%s) - start)) s (exit $$code)" >&2; exit $$code
+# A sweep's further cases (marked `full`) run under make test-all only; each test says what make test still covers.
 test: $(STAMP)
+	@$(call timed,CPU-clock,$(VENV)/bin/python -m pytest -q -n auto -m "not ($(REALTIME) or full)")
+	@$(call timed,wall-clock,$(VENV)/bin/python -m pytest -q -n $(WALL_WORKERS) --dist loadgroup -m "($(REALTIME)) and not full")
+
+test-all: $(STAMP)
 	@$(call timed,CPU-clock,$(VENV)/bin/python -m pytest -q -n auto -m "not ($(REALTIME))")
 	@$(call timed,wall-clock,$(VENV)/bin/python -m pytest -q -n $(WALL_WORKERS) --dist loadgroup -m "$(REALTIME)")
 
 # The tests that run on the CPU clock alone, without the long simulations.
 test-fast: $(STAMP)
-	$(VENV)/bin/python -m pytest -q -n auto -m "not ($(REALTIME) or slow)"
+	$(VENV)/bin/python -m pytest -q -n auto -m "not ($(REALTIME) or slow or full)"
 
 # Regenerate the shipped waypoint table from the two shipped calibrations (a test fails when it is stale).
 tables: $(STAMP)
