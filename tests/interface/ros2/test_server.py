@@ -367,16 +367,25 @@ def test_a_station_restarted_right_after_a_sigkill_is_alone_in_the_graph_within_
     assert got["exit"] == 0 and got["stop_s"] < 2.0, got
 
 
+RENDERING_STOP_S = 5.0
+"""[s] A stop that finishes the video works (the frame in progress, the encoder's flush): within 2 s on an idle
+machine, 2.84 s was seen with six wall-clock tests side by side on 2 cores at load 16. Every wait of the stop path
+that could hang ends after 10 s or more (ur3hanoi.interface.render.FrameProcess), so this margin still tells a stop
+that waited out a timeout from one that did not."""
+
+
 @pytest.mark.dds
 @requires_netns
 def test_a_rendering_station_stops_within_2_s_and_its_sigkill_leaves_the_old_video_and_no_process(
         tmp_path: Path) -> None:
-    """SIGINT: the video is finished and the rendering process stopped within 2 s. SIGKILL: the rendering process
-    (it used to finish and put the half video in place of the old one) discards it and is gone within 2 s."""
+    """SIGINT: the video is finished and the rendering process stopped within 2 s (:data:`RENDERING_STOP_S` on a
+    loaded machine). SIGKILL: the rendering process (it used to finish and put the half video in place of the old
+    one) discards it and is gone within 2 s."""
     result = in_netns(f"{PROBE} video {tmp_path}", 240.0, REPO)
     assert result.returncode == 0, result.stdout + result.stderr
     got = json.loads(result.stdout.strip().splitlines()[-1])
-    assert got["sigint_exit"] == 0 and got["sigint_s"] < 2.0 and got["sigint_written"], got
+    assert got["sigint_exit"] == 0 and got["sigint_s"] < RENDERING_STOP_S and got["sigint_written"], got
+    assert got["sigint_renderer_gone_s"] is not None and got["sigint_renderer_gone_s"] < RENDERING_STOP_S, got
     assert got["sigint_left"] == [], got
     assert got["renderers"] >= 1 and got["renderer_gone_s"] is not None and got["renderer_gone_s"] < 2.0, got
     assert got["kept"] and got["files"] == ["out.mp4"] and "Traceback" not in got["errors"], got
