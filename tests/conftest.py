@@ -60,8 +60,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         if shared:
             params = getattr(getattr(item, "callspec", None), "params", {})
             values = [f"{name}={params[name]}" for name in shared if name in params]
-            item.add_marker(pytest.mark.xdist_group("|".join([item.module.__name__, *values])))
-    if config.getvalue("loadgroup"):
+            item.add_marker(pytest.mark.xdist_group("|".join([item.nodeid.split("::", 1)[0], *values])))
+    if getattr(config.option, "loadgroup", False):  # set in the workers of --dist loadgroup
         _group_ids(items)
 
 
