@@ -53,17 +53,26 @@ def wait_for(predicate: Callable[[], bool], timeout_s: float) -> float | None:
     return None
 
 
-def station(folder: Path, name: str, *args: str) -> subprocess.Popen[str]:
-    """A ros2-station (stdout/stderr to files in ``folder``), once its ready line is out."""
-    out = folder / f"{name}.out"
-    with open(out, "w") as stdout, open(folder / f"{name}.err", "w") as stderr:
-        proc = subprocess.Popen([sys.executable, "-m", "ur3hanoi.cli", "ros2-station", "--report",
+def start_station(folder: Path, name: str, *args: str) -> subprocess.Popen[str]:
+    """A ros2-station started (stdout/stderr to files in ``folder``); :func:`ready` waits for it."""
+    with open(folder / f"{name}.out", "w") as stdout, open(folder / f"{name}.err", "w") as stderr:
+        return subprocess.Popen([sys.executable, "-m", "ur3hanoi.cli", "ros2-station", "--report",
                                  str(folder / f"{name}.json"), *args], stdout=stdout, stderr=stderr, text=True)
+
+
+def ready(proc: subprocess.Popen[str], folder: Path, name: str) -> subprocess.Popen[str]:
+    """``proc`` once its ready line is out."""
+    out = folder / f"{name}.out"
     if wait_for(lambda: "ros2-station: ready" in out.read_text() or proc.poll() is not None, 90.0) is None \
             or proc.poll() is not None:
         proc.kill()
         raise SystemExit(f"station {name} not ready: {out.read_text()} {(folder / f'{name}.err').read_text()}")
     return proc
+
+
+def station(folder: Path, name: str, *args: str) -> subprocess.Popen[str]:
+    """A ros2-station (stdout/stderr to files in ``folder``), once its ready line is out."""
+    return ready(start_station(folder, name, *args), folder, name)
 
 
 def stop(proc: subprocess.Popen[str], sig: signal.Signals) -> tuple[int, float]:
@@ -93,9 +102,10 @@ def restart(folder: Path) -> dict[str, Any]:
     first.kill()
     t0 = time.monotonic()
     first.wait()
-    second = station(folder, "b")
-    gone = wait_for(lambda: ghost not in others(), 30.0)
+    second = start_station(folder, "b")  # watched while it starts: its start (seconds on a busy machine) is not the
+    gone = wait_for(lambda: ghost not in others(), 30.0)  # ghost's time
     ghost_s = None if gone is None else time.monotonic() - t0
+    ready(second, folder, "b")
     positions.take(N=1000)
     got = wait_for(lambda: bool(positions.take(N=10)), 5.0) is not None
     after = len(others())

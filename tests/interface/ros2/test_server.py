@@ -270,9 +270,14 @@ kill -INT $ST; wait $ST; echo "station exit $?" >&2
     assert flood["sent"] >= 0.9 * 1000 * seconds
     assert flood["positions"] >= 0.5 * 125 * seconds
     assert flood["max_gap_s"] < 0.25, flood  # 2 periods is the target; this bounds a stall on any shared CPU
-    lines = _log_lines(err)
-    assert 1 <= len(lines) <= seconds + 3, lines[:5]
     r = json.loads(report.read_text())
+    lines = _log_lines(err)
+    # The refusals: about one line a second. A busy machine adds the loop's lag warnings, a source of their own
+    # limited the same way (one line a second of the station's run).
+    refusals = [line for line in lines if "ur3e/command" in line]
+    lags = [line for line in lines if line.startswith("[WARN] loop: ")]
+    assert 1 <= len(refusals) <= seconds + 3, refusals[:5]
+    assert len(refusals) + len(lags) == len(lines) and len(lags) <= r["wall_time_s"] + 1, lines
     c = r["commands"]
     assert c["executed"] + c["rejected"] + c["queued"] == r["transport"]["received"] <= flood["sent"]
     assert r["transport"]["received"] >= 0.5 * flood["sent"]  # DDS keep-last 10 may drop some at this rate
