@@ -29,7 +29,7 @@ solve: $(STAMP)
 # namespace, files and processes (tests/support/ros_support.py, ros2_support.py, reaper.py). The tests of a module
 # that share a module-scoped station stay on one worker (--dist loadgroup, tests/conftest.py).
 REALTIME := ros or dds or rclpy or packaging
-WALL_WORKERS ?= 4
+WALL_WORKERS ?= 6
 timed = start=$$(date +%s); $(2); code=$$?; echo "make $@: $(1) phase took $$(($$(date +%s) - start)) s (exit $$code)" >&2; exit $$code
 # A sweep's further cases (marked `full`) run under make test-all only; each test says what make test still covers.
 test: $(STAMP)
