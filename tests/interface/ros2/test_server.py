@@ -375,8 +375,8 @@ def test_a_station_restarted_right_after_a_sigkill_is_alone_in_the_graph_within_
 RENDERING_STOP_S = 5.0
 """[s] A stop that finishes the video works (the frame in progress, the encoder's flush): within 2 s on an idle
 machine, 2.84 s was seen with six wall-clock tests side by side on 2 cores at load 16. Every wait of the stop path
-that could hang ends after 10 s or more (ur3hanoi.interface.common.render.FrameProcess), so this margin still tells a stop
-that waited out a timeout from one that did not."""
+that could hang ends after 10 s or more (ur3hanoi.interface.common.render.FrameProcess), so this margin still tells a
+stop that waited out a timeout from one that did not."""
 
 
 @pytest.mark.dds
