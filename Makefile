@@ -27,10 +27,12 @@ solve: $(STAMP)
 # ones on the wall clock (ROS 1, DDS, rclpy) and the wheel build run after them, WALL_WORKERS side by side: their
 # processes mostly wait on real time (control cycles, DDS discovery, pip), and each test owns its master port, network
 # namespace, files and processes (tests/support/ros_support.py, ros2_support.py, reaper.py). The tests of a module
-# that share a module-scoped station stay on one worker (--dist loadgroup, tests/conftest.py).
+# that share a module-scoped station stay on one worker (--dist loadgroup, tests/support/xdist_groups.py).
 REALTIME := ros or dds or rclpy or packaging
 WALL_WORKERS ?= 6
+# $(call timed,NAME,COMMAND): COMMAND, then its wall time on stderr; the exit status is COMMAND's.
 timed = start=$$(date +%s); $(2); code=$$?; echo "make $@: $(1) phase took $$(($$(date +%s) - start)) s (exit $$code)" >&2; exit $$code
+
 # A sweep's further cases (marked `full`) run under make test-all only; each test says what make test still covers.
 test: $(STAMP)
 	@$(call timed,CPU-clock,$(VENV)/bin/python -m pytest -q -n auto -m "not ($(REALTIME) or full)")
