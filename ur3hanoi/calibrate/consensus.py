@@ -2,11 +2,11 @@
 
 A leave-one-out residual cannot say which point is wrong when the wrong one shares its tower with good ones: the
 home pose recorded as tower 1 height 2 bends tower 1's step, and then the good height 3 looks 393 mm off. Nor can
-the points alone say anything about a tower taught once. So every hypothesis "point j is wrong" is tried: the
-other points are judged on everything the calibration knows (:func:`ur3hanoi.calibrate.evidence.judge`: positions,
-the tool's orientation, the height step and block size, the approach, the base's layout moved and turned as a
-whole, each against the audit's always-flagged limit), and the hypothesis that leaves them consistent is the answer
-(:func:`decide`).
+the points alone say where a tower taught once stands (only its level and axis). So every hypothesis "point j is
+wrong" is tried: the other points are judged on everything the calibration knows that does not depend on where the
+towers stand (:func:`ur3hanoi.calibrate.evidence.judge`: positions, the table's levels, the tool's axis, the height
+step and block size, the approach, distinct towers, each against the audit's always-flagged limit), and the
+hypothesis that leaves them consistent is the answer (:func:`decide`).
 
 The decision: when all the candidates are consistent, no point is grossly wrong (``agree``). Otherwise each
 candidate is left out in turn (not the ``accepted`` ones). Among the hypotheses that leave the rest consistent,
@@ -81,8 +81,10 @@ def _suspects(ev: Evidence, candidates: BoolArray, whole: Judgement) -> list[int
     for c in whole.checks:
         if not c.over or c.soft:
             continue
-        if c.what == "layout":
+        if c.what in ("level", "lean"):
             involved = [i for i in cand if ev.slots[i][0] == c.index]
+        elif c.what == "distinct":
+            involved = [i for i in cand if ev.slots[i][0] in (c.index, c.other)]
         elif c.what == "step":
             involved = [i for i in cand if ev.slots[i][2] == ON]
         else:
@@ -95,7 +97,7 @@ def _suspects(ev: Evidence, candidates: BoolArray, whole: Judgement) -> list[int
 def consensus(base: Station, slots: Sequence[Slot], m: Measured, candidates: BoolArray,
               accepted: BoolArray | None = None) -> Consensus:
     """:func:`decide` for the points measured at ``slots`` (``m``) of which ``candidates`` may take part;
-    ``accepted`` points are never left out and their towers never judged by the layout."""
+    ``accepted`` points are never left out and their towers never judged by their level or axis."""
     ok = np.zeros(len(slots), dtype=bool) if accepted is None else np.asarray(accepted, dtype=bool)
     return decide(Evidence(base=base, slots=tuple(slots), m=m, accepted=ok & candidates), candidates)
 

@@ -25,7 +25,7 @@ consistent when nothing is over its limit:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -38,9 +38,8 @@ from ur3hanoi.calibrate.limits import (
     CONTACT_FLAG_MM,
     MAX_APPROACH_M,
     TILT_FLAG_DEG,
-    angle_deg,
-    table_axis,
 )
+from ur3hanoi.calibrate.table_checks import TOWER_TILT_DEG, distinct_checks, level_checks, share, tilt_checks
 from ur3hanoi.errors import printable
 from ur3hanoi.robot.ik import wrap_angle
 from ur3hanoi.station.calibration import Station
@@ -52,7 +51,8 @@ HEADING_DEG = 15.0
 SPREAD_SIGMAS = 5.0
 """Headings and approach heights: a point past this many times the others' spread (their median deviation) disagrees
 when that is more than the limit (the data's own scatter sets the bar where hand-recorded tables scatter widely)."""
-BY_POINTS, BY_LAYOUT = "points", "layout"
+BY_POINTS, BY_LEVEL = "points", "level"
+BY_LAYOUT = BY_LEVEL  # the name issue 33 used; a tower taught once is judged by its level now
 
 
 @dataclass(frozen=True)
@@ -67,6 +67,7 @@ class Check:
     value: float
     share: float
     soft: bool = False
+    other: int = -1
 
     @property
     def over(self) -> bool:
@@ -85,8 +86,10 @@ class Judgement:
         expected_m: (N, 3) [m, world] where the kept points put each point's slot (NaN where they cannot say).
         off_mm: (N,) each point's distance [mm] from where the others put it: for a kept point the check that
             judged it (NaN when none could), for one left out its distance from ``expected_m``.
-        by: per point, :data:`BY_POINTS` or :data:`BY_LAYOUT` (what placed it), or "".
-        layout: the base's layout fitted to the kept towers (None with none).
+        by: per point, :data:`BY_POINTS` (the other points placed it) or :data:`BY_LEVEL` (its tower's only
+            contact: only its height is judged, by the other towers' level), or "".
+        layout: the base's layout fitted to the kept towers (None with none): a hint, never evidence.
+        level_m: (H,) [m, world] each height's level where the kept towers put it (NaN with none).
     """
 
     kept: BoolArray
@@ -98,6 +101,7 @@ class Judgement:
     off_mm: FloatArray
     by: tuple[str, ...]
     layout: LayoutFit | None
+    level_m: FloatArray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def consistent(self) -> bool:
@@ -236,25 +240,36 @@ def _headings(ev: Evidence, kept: np.ndarray) -> list[Check]:
                                                                                                   strict=True)]
 
 
-def _layout_checks(ev: Evidence, origins: FloatArray, single: dict[int, int], accepted_towers: set[int]
-                   ) -> tuple[list[Check], dict[int, FloatArray], LayoutFit | None]:
-    """Each tower taught once against the base's layout fitted to the other towers; where the layout puts every
-    tower [mm]; the layout fitted to all the towers (the accepted ones aside)."""
+def _layout(ev: Evidence, origins: FloatArray) -> tuple[dict[int, FloatArray], LayoutFit | None]:
+    """Where the base's layout, moved and turned onto the other towers, puts every tower [mm] (a hint for what
+    happened to a point, never evidence: real towers stand anywhere), and the layout fitted to all the towers."""
     base_mm, fitted_mm = ev.base_origins_mm, origins * 1e3
     pivot = base_mm.mean(axis=0)
     present = [t for t in range(len(origins)) if not np.isnan(origins[t, 0])]
-    refs = [t for t in present if t not in accepted_towers]
-    checks, places = [], {}
+    places = {}
     for t in range(len(origins)):
-        place = tower_place(base_mm, fitted_mm, t, [r for r in refs if r != t], pivot)
-        if place is None:
-            continue
-        places[t] = place
-        if t in single and t not in accepted_towers:
-            d = float(np.linalg.norm(fitted_mm[t] - place))
-            checks.append(Check("layout", t, d, d / CONTACT_FLAG_MM))
-    whole = fit_layout(base_mm[refs], fitted_mm[refs], pivot) if refs else None
-    return checks, places, whole
+        place = tower_place(base_mm, fitted_mm, t, [r for r in present if r != t], pivot)
+        if place is not None:
+            places[t] = place
+    whole = fit_layout(base_mm[present], fitted_mm[present], pivot) if present else None
+    return places, whole
+
+
+def _table_checks(ev: Evidence, origins: FloatArray, contact: np.ndarray, accepted_towers: set[int]) -> list[Check]:
+    """The layout-independent evidence (:mod:`ur3hanoi.calibrate.table_checks`): levels, the tool's axis, distinct
+    towers."""
+    towers = [ev.slots[i][0] for i in contact]
+    judged = [t for t in sorted(set(towers)) if t not in accepted_towers]
+    checks = [Check("level", t, dz, share(dz, CONTACT_FLAG_MM)) for t, dz in level_checks(origins, judged)]
+    per_point, lean, table = tilt_checks(ev.m.R_world[contact, :, 2], towers)
+    checks += [Check("tilt", int(contact[j]), a, a / TILT_FLAG_DEG) for j, a in per_point]
+    checks += [Check("lean", t, a, a / TOWER_TILT_DEG) for t, a in lean if t not in accepted_towers]
+    checks += [Check("axis", int(contact[j]), a, a / TILT_FLAG_DEG, soft=True) for j, a in table]
+    block_mm = ev.base.block_size * 1e3
+    checks += [Check("distinct", a, d, block_mm / max(d, 1e-6), other=b)
+               for a, b, d in distinct_checks(origins, ev.base.block_size)
+               if not (a in accepted_towers and b in accepted_towers)]
+    return checks
 
 
 def judge(ev: Evidence, kept: BoolArray) -> Judgement:
@@ -283,26 +298,29 @@ def judge(ev: Evidence, kept: BoolArray) -> Judgement:
     towers = [ev.slots[i][0] for i in contact]
     single = {t: int(contact[j]) for j, t in enumerate(towers) if towers.count(t) == 1}
     accepted_towers = {ev.slots[i][0] for i in contact if ev.accepted[i]}
-    layout_checks, places, layout = _layout_checks(ev, origins, single, accepted_towers)
-    checks += layout_checks
-    for c in layout_checks:
-        off[single[c.index]], by[single[c.index]] = c.value, BY_LAYOUT
-    if len(contact):
-        axes = ev.m.R_world[contact, :, 2]
-        tilt = angle_deg(axes, table_axis(axes))
-        checks += [Check("tilt", int(i), float(a), float(a) / TILT_FLAG_DEG)
-                   for i, a in zip(contact, tilt, strict=True)]
+    places, layout = _layout(ev, origins)
+    table = _table_checks(ev, origins, contact, accepted_towers)
+    checks += table
+    for c in table:  # a tower taught once: judged by its level alone (nothing checks it sideways)
+        if c.what == "level" and c.index in single:
+            off[single[c.index]], by[single[c.index]] = abs(c.value), BY_LEVEL
     expected, under = _expected(ev, origins, step, places, kept)
+    present = ~np.isnan(origins[:, 0])
+    z0 = float(np.median(origins[present, 2])) if present.any() else np.nan
+    level = np.array([z0 + h * step[2] for h in range(ev.base.n_heights)])  # [m] each height's level on the table
     for i in np.flatnonzero(kept & ~is_on):
         checks += _above_checks(ev, int(i), under[i], bool(can[i]))
     checks += _approach_checks(ev, [int(i) for i in np.flatnonzero(kept & ~is_on) if not np.isnan(under[i, 0])],
                                under)
     checks += _headings(ev, np.flatnonzero(kept))
     for i in np.flatnonzero(~kept):
-        off[i] = float(np.linalg.norm(ev.m.p_world[i] - expected[i])) * 1e3
-        by[i] = BY_POINTS if not np.isnan(origins[ev.slots[i][0], 0]) else BY_LAYOUT
+        t, h, _ = ev.slots[i]
+        if not np.isnan(origins[t, 0]):
+            off[i], by[i] = float(np.linalg.norm(ev.m.p_world[i] - expected[i])) * 1e3, BY_POINTS
+        elif is_on[i] and not np.isnan(level[h]):  # its tower's only contact: only the level can say
+            off[i], by[i] = abs(float(ev.m.p_world[i, 2] - level[h])) * 1e3, BY_LEVEL
     return Judgement(kept=kept.copy(), checks=tuple(checks), origins_m=origins, step_m=step, step_fitted=step_fitted,
-                     expected_m=expected, off_mm=off, by=tuple(by), layout=layout)
+                     expected_m=expected, off_mm=off, by=tuple(by), layout=layout, level_m=level)
 
 
 def _expected(ev: Evidence, origins: FloatArray, step: FloatArray, places: dict[int, FloatArray],
@@ -354,4 +372,5 @@ def _approach_checks(ev: Evidence, above: list[int], under: FloatArray) -> list[
     return out
 
 
-__all__ = ["BY_LAYOUT", "BY_POINTS", "HEADING_DEG", "SPREAD_SIGMAS", "Check", "Evidence", "Judgement", "judge"]
+__all__ = ["BY_LAYOUT", "BY_LEVEL", "BY_POINTS", "HEADING_DEG", "SPREAD_SIGMAS", "Check", "Evidence", "Judgement",
+           "judge"]

@@ -51,6 +51,7 @@ from ur3hanoi.calibrate.limits import ABOVE_FLAG_LINE_MM, CONTACT_FLAG_MM, MAX_A
 from ur3hanoi.calibrate.prepare import MAX_TILT_DEG, Prepared, fail, prepare, underdetermined
 from ur3hanoi.calibrate.result import CalibrationFit, Suspect
 from ur3hanoi.calibrate.robust import RobustFit, robust_fit
+from ur3hanoi.calibrate.table_checks import single_pose_towers
 from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
 from ur3hanoi.calibrate.verdict import named_text, refusal, slot_text, unexplained, where_text
 from ur3hanoi.errors import CalibrationError, printable
@@ -235,23 +236,15 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
 def _with_consensus(fit: CalibrationFit, prep: Prepared, c: Consensus) -> CalibrationFit:
     """The fit with what the consensus said: each point's distance from where the others put it, the points taken
     on the student's word, and, when no single point explains a disagreement the robust fit left, why."""
-    accepted: tuple[tuple[int, float], ...] = ()
-    if prep.evidence.accepted.any():  # how far the layout would have put their towers
-        kept = prep.candidates & ~np.isin(np.arange(len(fit.points)), c.wrong)
-        word = replace(prep.evidence, accepted=np.zeros(len(fit.points), dtype=bool))
-        layout = {ch.index: ch.value for ch in judge(word, kept).checks if ch.what == "layout"}
-        accepted = tuple((int(i), float(layout.get(fit.points[i].tower, math.nan)))
-                         for i in np.flatnonzero(prep.evidence.accepted))
+    accepted = tuple((int(i), math.nan) for i in np.flatnonzero(prep.evidence.accepted))
+    usable = np.array(fit.used) & prep.candidates
+    single = single_pose_towers([(p.tower, p.height, p.k) for p in fit.points], usable)
+    lean = {ch.index: ch.value for ch in judge(prep.evidence, usable).checks if ch.what == "lean"}
     out = replace(fit, consensus=c.kind, named=c.wrong, off_mm=c.chosen.off_mm, judged_by=c.chosen.by,
-                  accepted=accepted)
+                  accepted=accepted,
+                  single_pose=tuple((t, i, lean.get(t, math.nan)) for t, i in sorted(single.items())))
     if c.kind == "unexplained" and fit.sound:
-        # The robust fit's choice, judged again; a tower it kept one of several contacts of stands where they agree
-        # (swapped heights, say), so only a tower taught once is judged by the base's layout.
-        left = judge(prep.evidence, np.array(fit.used) & prep.candidates)
-        taught_once = {p.tower for i, p in enumerate(fit.points) if prep.candidates[i] and p.k == ON and sum(
-            prep.candidates[k] and q.k == ON and q.tower == p.tower for k, q in enumerate(fit.points)) == 1}
-        left = replace(left, checks=tuple(ch for ch in left.checks if ch.what != "layout" or ch.index in taught_once))
-        problem = unexplained(prep.evidence, left, fit.points)
+        problem = unexplained(prep.evidence, judge(prep.evidence, usable), fit.points)  # the robust fit's choice
         if problem:
             out = replace(out, problem=problem, warnings=(*fit.warnings, f"the fit is not sound: {problem}"))
     return out

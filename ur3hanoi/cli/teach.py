@@ -238,7 +238,7 @@ def _finish(args: argparse.Namespace, base: Station, base_label: str, taught: Ta
     """Fit, print the audit, write the calibration and the table key, say how accurate it is and what to run."""
     from ur3hanoi.audit import audit_taught
     from ur3hanoi.calibrate import fit_station, write_calibration
-    from ur3hanoi.calibrate.verdict import accepted_lines
+    from ur3hanoi.calibrate.verdict import note_lines
     from ur3hanoi.cli.tables import write_key
     from ur3hanoi.errors import TaughtPointsError
     from ur3hanoi.teach.feedback import feedback
@@ -253,7 +253,7 @@ def _finish(args: argparse.Namespace, base: Station, base_label: str, taught: Ta
     print(audit_taught(fit, points).text())
     write_calibration(station_out, fit, points, base, taught_label=taught.path.as_posix(), base_label=base_label,
                       inputs=[input_file(args.base), taught.path])
-    for line in accepted_lines(fit.points, fit.accepted, base_label):
+    for line in note_lines(fit.points, fit.accepted, fit.single_pose, base_label):
         print(line)
     fb = feedback(base, points, base_label, accept)
     worst = max((r.off_mm for r in fb.rows if not math.isnan(r.off_mm) and fit.used[r.index]), default=math.nan)
