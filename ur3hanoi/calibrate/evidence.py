@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.calibrate.grid_fit import BoolArray, Measured, default_height_step
+from ur3hanoi.calibrate.grid_fit import FLAT_STEP_PASSES, BoolArray, Measured, default_height_step
 from ur3hanoi.calibrate.layout import LayoutFit, fit_layout, tower_place
 from ur3hanoi.calibrate.limits import (
     ABOVE_FLAG_LINE_MM,
@@ -198,7 +198,7 @@ def _grid(ev: Evidence, kept: np.ndarray) -> tuple[FloatArray, FloatArray, bool,
     h_rows = np.array([ev.slots[i][1] for i, _ in rows], dtype=float)
     a_rows = np.array([a for _, a in rows], dtype=int)
     step, origins, x = default_height_step(base, None), np.full((n_t, 3), np.nan), np.zeros(A.shape[1])
-    for _ in range(1 if fitted else 3):  # an unfitted flat step turns with the towers it places
+    for _ in range(1 if fitted else FLAT_STEP_PASSES):  # an unfitted flat step turns with the towers it places
         if rows:
             x = np.linalg.lstsq(A, p - (0.0 if fitted else h_rows * step[a_rows]), rcond=None)[0]
             origins = np.where(present[:, None], x[:3 * n_t].reshape(n_t, 3), np.nan)
@@ -206,7 +206,11 @@ def _grid(ev: Evidence, kept: np.ndarray) -> tuple[FloatArray, FloatArray, bool,
             step = np.zeros(3)
             step[list(axes)] = x[3 * n_t:3 * n_t + len(axes)]
         else:
-            step = _prior_step(base, origins)
+            new = _prior_step(base, origins)
+            settled = bool(np.max(np.abs(new - step)) < 1e-13)
+            step = new
+            if settled:
+                break
     dev, can = np.full((n, 3), np.nan), np.zeros(n, dtype=bool)
     if rows:
         residual = p - A @ x - (0.0 if fitted else h_rows * step[a_rows])
