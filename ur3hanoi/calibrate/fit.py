@@ -208,6 +208,8 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
         raise underdetermined(where, base, points, candidates, prep.hard)
     fit = robust_fit(base, model, prep.safe_slots, prep.m, candidates, tol_mm, tol_deg)
     c = prep.consensus
+    if c.kind in ("undecided", "unexplained") and _scatter(c, fit, prep):
+        c = replace(c, kind="agree", wrong=(), alone=False, chosen=c.whole)
     named = {i: named_text(prep.evidence, c, i, points) for i in c.wrong}
     refused = c.kind == "undecided" or (c.kind == "named" and c.alone)
     problem = refusal(prep.evidence, c, points) if refused else ""
@@ -313,6 +315,20 @@ def _bends(fit: RobustFit, prep: Prepared, candidates: BoolArray) -> bool:
     return False
 
 
+def _scatter(c: Consensus, fit: RobustFit, prep: Prepared) -> bool:
+    """Whether what the consensus could not pin on one point is the station's scatter, as the audit judges it
+    (``check-table --fit`` calls such a table clean, and the two must agree): only contacts the others check were
+    off, and the robust fit leaves every contact within the always-flagged distance (a contact it left out: of the
+    grid fitted without it)."""
+    over = [ch for ch in c.whole.checks if ch.over and not ch.soft]
+    if not over or any(ch.what != "point" for ch in over):
+        return False
+    residual = np.linalg.norm(prep.m.p_world - fit.solution.points(prep.safe_slots), axis=1) * 1e3
+    dev = np.where(fit.used & fit.removable, fit.deviation_mm, residual)
+    on = prep.candidates & np.array([s[2] == ON for s in prep.safe_slots])
+    return bool(np.all(dev[on] <= CONTACT_FLAG_MM))
+
+
 def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray, points: Sequence[TaughtPoint]) -> str:
     """Why the remaining fit cannot be trusted ("" if it can)."""
     n = int(candidates.sum())
@@ -321,14 +337,18 @@ def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray, points
     if left_out >= max(1, (n - 1) // 2) and over.any():
         return (f"{left_out} of {n} points left out and more still disagree with the grid: check the base "
                 "calibration's robot base and tool, and the tower/height labels")
-    stuck = over & ~fit.removable  # the others do not determine the grid without them (pruning drops the others)
+    # The others do not determine the grid without them (pruning drops the others): judged by the always-flagged
+    # distance, not the fit's few-mm floors (a contact and the above pose over it disagree by twice the recording
+    # noise, 1-3 mm each, and the calibration averages them).
+    flag = np.array([CONTACT_FLAG_MM if p.k == ON else ABOVE_FLAG_LINE_MM for p in points])
+    stuck = fit.used & (dev_mm > flag) & ~fit.removable
     if stuck.any():
         worst = sorted(np.flatnonzero(stuck), key=lambda i: -dev_mm[i])
         named = [f"{slot_text(points[i])} ({dev_mm[i]:.1f} mm)" for i in worst[:3]]
         more = f" and {len(worst) - 3} more" if len(worst) > 3 else ""
         return (f"{', '.join(named)}{more}, which the fit cannot do without, {'is' if len(worst) == 1 else 'are'} "
-                f"more than {fit.thresholds.mm:.1f} mm off the grid: re-record {'it' if len(worst) == 1 else 'them'} "
-                "or add points")
+                f"more than the always-flagged {CONTACT_FLAG_MM:g} mm ({ABOVE_FLAG_LINE_MM:g} mm for an above pose) "
+                f"off the grid: re-record {'it' if len(worst) == 1 else 'them'} or add points")
     return ""
 
 

@@ -34,9 +34,9 @@ from ur3hanoi.tables import Slot
 
 BoolArray = npt.NDArray[np.bool_]
 
-_SINGULAR = 1e-9
+_SINGULAR = 1e-9  # smallest eigenvalue of I - H_ii for a point that can be left out
 FLAT_STEP_PASSES = 60
-"""At most this many fixed-point passes turn a flat layout's unfitted step with its tower row (:func:`solve`)."""  # smallest eigenvalue of I - H_ii for a point that can be left out
+"""At most this many fixed-point passes turn a flat layout's unfitted step with its tower row (:func:`solve`)."""
 
 
 @dataclass(frozen=True)
