@@ -169,8 +169,12 @@ def tower_error_mm(fitted: Station, truth: Station) -> float:
                for t in range(truth.n_towers) for h in range(truth.n_heights))
 
 
-def outcome(case: Case) -> tuple[str, str]:
-    """(the outcome, what was said) of calibrating ``case`` (see the module docstring)."""
+def outcome(case: Case, named_ref: Station | None = None, kept_ref: Station | None = None,
+            slack_mm: float = HIDDEN_TOWER_MM, named_mm: float = TOWER_MM) -> tuple[str, str]:
+    """(the outcome, what was said) of calibrating ``case`` (see the module docstring). ``named_ref``: where the
+    good points put the towers (default: the truth), ``kept_ref``: where all the good points do (default: the truth),
+    ``slack_mm``: how far the truth's towers may stand from their own points (the hidden towers' offsets, or the
+    recording noise); ``named_mm``: how close a point named and left out leaves every tower to ``named_ref``."""
     try:
         fit = fit_station(case.truth.base, case.taught)
     except TaughtPointsError as exc:  # too little left to fit: the message lists what was left out
@@ -184,19 +188,21 @@ def outcome(case: Case) -> tuple[str, str]:
             return "undecided", said
         named = any(s.index == case.wrong for s in fit.suspects)
         return "refused, named not first" if named else "refused, unnamed", said
-    worst = tower_error_mm(fit.station, case.truth.truth)
     if not fit.used[case.wrong]:
+        worst = tower_error_mm(fit.station, named_ref or case.truth.truth)
         if not first:
             return "left out, named not first", said
-        return ("named", said) if worst <= TOWER_MM else (f"named, but a tower {worst:.1f} mm off", said)
-    if worst <= FLAG_MM + HIDDEN_TOWER_MM:
+        return ("named", said) if worst <= named_mm else (f"named, but a tower {worst:.1f} mm off", said)
+    worst = tower_error_mm(fit.station, kept_ref or case.truth.truth)
+    if worst <= FLAG_MM + slack_mm:
         return "kept", said
-    if unseen(case, fit.station, fit.single_pose):
+    if unseen(case, fit.station, fit.single_pose, slack_mm):
         return "said", said
     return f"written bent: a tower {worst:.1f} mm off", said
 
 
-def unseen(case: Case, fitted: Station, single_pose: tuple[tuple[int, int, float], ...]) -> bool:
+def unseen(case: Case, fitted: Station, single_pose: tuple[tuple[int, int, float], ...],
+           slack_mm: float = HIDDEN_TOWER_MM) -> bool:
     """Whether the wrong point, written, moved only what no evidence sees, and the output says so (issue 37): its
     tower rests on it alone (named in :attr:`ur3hanoi.calibrate.result.CalibrationFit.single_pose`), and the
     calibration differs from the truth sideways only: every level within the always-flagged distance (plus the
@@ -205,7 +211,7 @@ def unseen(case: Case, fitted: Station, single_pose: tuple[tuple[int, int, float
     t_wrong = case.slots[case.wrong][0]
     if (t_wrong, case.wrong) not in {(t, i) for t, i, _ in single_pose}:
         return False
-    truth, limit = case.truth.truth, FLAG_MM + HIDDEN_TOWER_MM
+    truth, limit = case.truth.truth, FLAG_MM + slack_mm
     for t in range(truth.n_towers):
         for h in range(truth.n_heights):
             d = (contact_point_world(fitted, t, h) - contact_point_world(truth, t, h)) * 1e3

@@ -1,8 +1,10 @@
-"""Judge a set of taught points on all the evidence a calibration has: where they are, the tool's orientation, the
-height step and block size, the approach, and the base calibration's layout moved and turned as a whole
-(:func:`judge`; :mod:`ur3hanoi.calibrate.consensus` tries the sets without each point in turn).
+"""Judge a set of taught points on all the evidence a calibration has that does not depend on where the towers
+stand: where the points are, the table's levels, the tool's axis, the height step and block size, the approach,
+distinct towers (:func:`judge`; :mod:`ur3hanoi.calibrate.consensus` tries the sets without each point in turn).
 
-The evidence, each with the audit's always-flagged limit (:mod:`ur3hanoi.calibrate.limits`); a set of points is
+The base calibration gives the robot, the tool, the block size and the approach, not where the towers stand: real
+stations' towers stand 12-105 mm from where its layout, moved and turned as a whole, puts them (issue 37). The
+evidence, each with the audit's always-flagged limit (:mod:`ur3hanoi.calibrate.limits`); a set of points is
 consistent when nothing is over its limit:
 
 - **positions**: a contact that the others check (its tower has another contact, or the step is fitted without it)
@@ -10,16 +12,20 @@ consistent when nothing is over its limit:
   its horizontal place, within :data:`ABOVE_FLAG_LINE_MM`, 10 mm: its height is the approach's);
 - **the height step and the block size**: when one tower alone fixes the step, the top level it gives is within
   8 mm of where the base's step (one block up; a flat base: its row step turned with the towers) puts it;
-- **the base's layout moved and turned as a whole**: a tower taught at one contact only stands within 8 mm of where
-  the base's layout, fitted to the other towers, puts it (:func:`ur3hanoi.calibrate.layout.tower_place`); a tower
-  the student vouched for (``accepted``) is not judged, nor used to place the others;
-- **the tool's orientation**: a contact's suction axis is within :data:`TILT_FLAG_DEG` (5 deg) of the others' (their
-  robust mean, :func:`ur3hanoi.calibrate.limits.table_axis`); its heading (the direction the arm came from) is
-  weighed, never alone a reason (a round cup does not care, and freedrive turns it): a heading more than
-  ``max(HEADING_DEG, 5 x the others' spread)`` from the others' counts against the point when hypotheses compete;
+- **the table's levels, the tool's axis, distinct towers** (:mod:`ur3hanoi.calibrate.table_checks`): every
+  tower's origin at the other towers' height within 8 mm; a contact's suction axis within :data:`TILT_FLAG_DEG`
+  (5 deg) of its tower's other contacts', a tower's within 8 deg of the other towers'; towers a block apart. A
+  tower the student vouched for (``accepted``) is not judged by these;
+- **the tool's heading** (the direction the arm came from) is weighed, never alone a reason (a round cup does not
+  care, and freedrive turns it): a heading more than ``max(HEADING_DEG, 5 x the others' spread)`` from the others'
+  counts against the point when hypotheses compete;
 - **the approach**: an above pose stands within :data:`ABOVE_FLAG_LINE_MM` (10 mm) of its tower's vertical line,
   at least :data:`ABOVE_MIN_MM` (5 mm) and at most :data:`MAX_APPROACH_M` over its contact, and as high over it as
   the other above poses (the calibration has one approach height): within ``max(8 mm, 5 x their spread)``.
+
+A tower taught at one contact is judged by its level and axis only: nothing checks where it stands along the table
+(a joint-1 offset moves it with nothing else changed); the calibration says so
+(:attr:`ur3hanoi.calibrate.result.CalibrationFit.single_pose`).
 """
 
 from __future__ import annotations
@@ -31,7 +37,7 @@ import numpy as np
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.calibrate.grid_fit import FLAT_STEP_PASSES, BoolArray, Measured, default_height_step
-from ur3hanoi.calibrate.layout import LayoutFit, fit_layout, tower_place
+from ur3hanoi.calibrate.layout import LayoutFit, fit_layout
 from ur3hanoi.calibrate.limits import (
     ABOVE_FLAG_LINE_MM,
     ABOVE_MIN_MM,
@@ -48,6 +54,9 @@ from ur3hanoi.tables import Slot
 
 HEADING_DEG = 15.0
 """[deg] a heading this far from the others' (or 5 times their spread) weighs against a point."""
+UNJUDGED_SCORE = 2.0
+"""What an above pose left with nothing to judge it adds to a hypothesis' score (two checks at their limit): with
+its tower's only contact left out, it would agree with anything."""
 SPREAD_SIGMAS = 5.0
 """Headings and approach heights: a point past this many times the others' spread (their median deviation) disagrees
 when that is more than the limit (the data's own scatter sets the bar where hand-recorded tables scatter widely)."""
@@ -90,6 +99,7 @@ class Judgement:
             contact: only its height is judged, by the other towers' level), or "".
         layout: the base's layout fitted to the kept towers (None with none): a hint, never evidence.
         level_m: (H,) [m, world] each height's level where the kept towers put it (NaN with none).
+        unjudged: how many kept above poses stand over a tower with no kept contact (nothing judges them).
     """
 
     kept: BoolArray
@@ -102,6 +112,7 @@ class Judgement:
     by: tuple[str, ...]
     layout: LayoutFit | None
     level_m: FloatArray = field(default_factory=lambda: np.zeros(0))
+    unjudged: int = 0
 
     @property
     def consistent(self) -> bool:
@@ -109,7 +120,9 @@ class Judgement:
 
     @property
     def score(self) -> float:
-        return float(sum(c.share**2 for c in self.checks if not c.soft or c.over))
+        """The checks' squared shares of their limits, plus :data:`UNJUDGED_SCORE` for each kept above pose over a
+        tower with no kept contact: a hypothesis that leaves a point nothing can judge explains less."""
+        return float(sum(c.share**2 for c in self.checks if not c.soft or c.over)) + UNJUDGED_SCORE * self.unjudged
 
 
 @dataclass(frozen=True)
@@ -244,19 +257,12 @@ def _headings(ev: Evidence, kept: np.ndarray) -> list[Check]:
                                                                                                   strict=True)]
 
 
-def _layout(ev: Evidence, origins: FloatArray) -> tuple[dict[int, FloatArray], LayoutFit | None]:
-    """Where the base's layout, moved and turned onto the other towers, puts every tower [mm] (a hint for what
-    happened to a point, never evidence: real towers stand anywhere), and the layout fitted to all the towers."""
-    base_mm, fitted_mm = ev.base_origins_mm, origins * 1e3
-    pivot = base_mm.mean(axis=0)
+def _layout(ev: Evidence, origins: FloatArray) -> LayoutFit | None:
+    """The base's layout moved and turned onto the towers the points place (how far they stand from it, for people:
+    never evidence, real towers stand anywhere); None with none."""
+    base_mm = ev.base_origins_mm
     present = [t for t in range(len(origins)) if not np.isnan(origins[t, 0])]
-    places = {}
-    for t in range(len(origins)):
-        place = tower_place(base_mm, fitted_mm, t, [r for r in present if r != t], pivot)
-        if place is not None:
-            places[t] = place
-    whole = fit_layout(base_mm[present], fitted_mm[present], pivot) if present else None
-    return places, whole
+    return fit_layout(base_mm[present], origins[present] * 1e3, base_mm.mean(axis=0)) if present else None
 
 
 def _table_checks(ev: Evidence, origins: FloatArray, contact: np.ndarray, accepted_towers: set[int]) -> list[Check]:
@@ -265,10 +271,9 @@ def _table_checks(ev: Evidence, origins: FloatArray, contact: np.ndarray, accept
     towers = [ev.slots[i][0] for i in contact]
     judged = [t for t in sorted(set(towers)) if t not in accepted_towers]
     checks = [Check("level", t, dz, share(dz, CONTACT_FLAG_MM)) for t, dz in level_checks(origins, judged)]
-    per_point, lean, table = tilt_checks(ev.m.R_world[contact, :, 2], towers)
+    per_point, lean = tilt_checks(ev.m.R_world[contact, :, 2], towers)
     checks += [Check("tilt", int(contact[j]), a, a / TILT_FLAG_DEG) for j, a in per_point]
     checks += [Check("lean", t, a, a / TOWER_TILT_DEG) for t, a in lean if t not in accepted_towers]
-    checks += [Check("axis", int(contact[j]), a, a / TILT_FLAG_DEG, soft=True) for j, a in table]
     block_mm = ev.base.block_size * 1e3
     checks += [Check("distinct", a, d, block_mm / max(d, 1e-6), other=b)
                for a, b, d in distinct_checks(origins, ev.base.block_size)
@@ -302,13 +307,13 @@ def judge(ev: Evidence, kept: BoolArray) -> Judgement:
     towers = [ev.slots[i][0] for i in contact]
     single = {t: int(contact[j]) for j, t in enumerate(towers) if towers.count(t) == 1}
     accepted_towers = {ev.slots[i][0] for i in contact if ev.accepted[i]}
-    places, layout = _layout(ev, origins)
+    layout = _layout(ev, origins)
     table = _table_checks(ev, origins, contact, accepted_towers)
     checks += table
     for c in table:  # a tower taught once: judged by its level alone (nothing checks it sideways)
         if c.what == "level" and c.index in single:
             off[single[c.index]], by[single[c.index]] = abs(c.value), BY_LEVEL
-    expected, under = _expected(ev, origins, step, places, kept)
+    expected, under = _expected(ev, origins, step, kept)
     present = ~np.isnan(origins[:, 0])
     z0 = float(np.median(origins[present, 2])) if present.any() else np.nan
     level = np.array([z0 + h * step[2] for h in range(ev.base.n_heights)])  # [m] each height's level on the table
@@ -324,11 +329,11 @@ def judge(ev: Evidence, kept: BoolArray) -> Judgement:
         elif is_on[i] and not np.isnan(level[h]):  # its tower's only contact: only the level can say
             off[i], by[i] = abs(float(ev.m.p_world[i, 2] - level[h])) * 1e3, BY_LEVEL
     return Judgement(kept=kept.copy(), checks=tuple(checks), origins_m=origins, step_m=step, step_fitted=step_fitted,
-                     expected_m=expected, off_mm=off, by=tuple(by), layout=layout, level_m=level)
+                     expected_m=expected, off_mm=off, by=tuple(by), layout=layout, level_m=level,
+                     unjudged=int(sum(np.isnan(under[i, 0]) for i in np.flatnonzero(kept & ~is_on))))
 
 
-def _expected(ev: Evidence, origins: FloatArray, step: FloatArray, places: dict[int, FloatArray],
-              kept: BoolArray) -> tuple[FloatArray, FloatArray]:
+def _expected(ev: Evidence, origins: FloatArray, step: FloatArray, kept: BoolArray) -> tuple[FloatArray, FloatArray]:
     """Where the kept points put each point's slot [m]: the tower's origin (the layout's place for a tower with no
     kept contact) plus its height's steps, an above pose at the kept above poses' approach (else the base's); and
     the contact point under each slot."""
@@ -336,9 +341,8 @@ def _expected(ev: Evidence, origins: FloatArray, step: FloatArray, places: dict[
     for i, (t, h, _) in enumerate(ev.slots):
         if not 0 <= t < ev.base.n_towers:
             continue
-        o = origins[t] if not np.isnan(origins[t, 0]) else (places[t] * 1e-3 if t in places else None)
-        if o is not None:
-            contact[i] = o + h * step
+        if not np.isnan(origins[t, 0]):  # a tower with no kept contact stands anywhere: nothing to expect
+            contact[i] = origins[t] + h * step
     above = [i for i in np.flatnonzero(kept) if ev.slots[i][2] == ABOVE and not np.isnan(contact[i, 0])]
     over = [float(ev.m.p_world[i][2] - contact[i][2]) for i in above]
     approach = float(np.median(over)) if over else ev.base.approach
@@ -376,5 +380,5 @@ def _approach_checks(ev: Evidence, above: list[int], under: FloatArray) -> list[
     return out
 
 
-__all__ = ["BY_LAYOUT", "BY_LEVEL", "BY_POINTS", "HEADING_DEG", "SPREAD_SIGMAS", "Check", "Evidence", "Judgement",
-           "judge"]
+__all__ = ["BY_LAYOUT", "BY_LEVEL", "BY_POINTS", "HEADING_DEG", "SPREAD_SIGMAS", "UNJUDGED_SCORE", "Check",
+           "Evidence", "Judgement", "judge"]

@@ -13,8 +13,7 @@ say holds on every station:
 - **the tool's axis** (:func:`tilt_checks`): a contact's suction axis within :data:`TILT_FLAG_DEG` (5 deg) of the
   other contacts of its tower; a tower's axis (all its contacts alike: how the student held the wrist there, up to
   6.3 deg on real stations) within :data:`TOWER_TILT_DEG` (8 deg) of the other towers'. A point tilted from the
-  others of its tower is wrong; a whole tower tilted alike is the tower's. A soft check weighs each contact's axis
-  against the table's (every contact's robust mean) when hypotheses compete.
+  others of its tower is wrong; a whole tower tilted alike is the tower's.
 - **distinct towers** (:func:`distinct_checks`): two towers' origins at least one block edge apart horizontally
   (closer, their blocks would overlap: a pose recorded for the wrong tower, or copied).
 
@@ -54,11 +53,10 @@ def level_checks(origins_m: FloatArray, judged: Sequence[int]) -> list[tuple[int
     return out
 
 
-def tilt_checks(axes: FloatArray, towers: Sequence[int]) -> tuple[list[tuple[int, float]], list[tuple[int, float]],
-                                                                   list[tuple[int, float]]]:
+def tilt_checks(axes: FloatArray, towers: Sequence[int]) -> tuple[list[tuple[int, float]], list[tuple[int, float]]]:
     """The tool's axis of contacts ``axes`` (N, 3) on ``towers`` (N,): (point, deg from the other contacts of its
     tower) for points with such mates; (tower, deg of its mean axis from the other towers') for every tower with
-    another beside it; (point, deg from the table's axis, :func:`ur3hanoi.calibrate.limits.table_axis`)."""
+    another beside it."""
     axes = np.asarray(axes, dtype=float).reshape(-1, 3)
     tw = np.asarray(towers, dtype=int)
     points, lean = [], []
@@ -71,8 +69,7 @@ def tilt_checks(axes: FloatArray, towers: Sequence[int]) -> tuple[list[tuple[int
         if len(others):
             ref = table_axis(others) if len(others) >= 3 else _unit(others.mean(axis=0))
             lean.append((t, float(angle_deg(_unit(axes[tw == t].mean(axis=0))[None, :], ref)[0])))
-    table = angle_deg(axes, table_axis(axes)) if len(axes) else np.zeros(0)
-    return points, lean, [(j, float(a)) for j, a in enumerate(table)]
+    return points, lean
 
 
 def distinct_checks(origins_m: FloatArray, block_m: float) -> list[tuple[int, int, float]]:

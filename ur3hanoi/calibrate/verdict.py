@@ -69,12 +69,10 @@ def accept_option(p: TaughtPoint) -> str:
 
 
 def _grid_points(ev: Evidence, j: Judgement) -> dict[tuple[int, int, int], np.ndarray]:
-    """Every slot's suction point [m] where the judged points put it (the base's layout places a tower they lack)."""
+    """Every slot's suction point [m] where the judged points put it (of the towers they place)."""
     out = {}
     for t in range(ev.base.n_towers):
-        o = j.origins_m[t]
-        if np.isnan(o[0]) and j.layout is not None:
-            o = j.layout.apply(np.asarray(ev.base.tower_origins[t]) * 1e3)[0] * 1e-3
+        o = j.origins_m[t]  # a tower with no judged contact stands anywhere: no slot of it to compare with
         for h in range(ev.base.n_heights):
             out[(t, h, ON)] = o + h * j.step_m
             out[(t, h, ABOVE)] = out[(t, h, ON)] + np.array([0.0, 0.0, ev.base.approach])
