@@ -190,6 +190,9 @@ def outcome(case: Case, named_ref: Station | None = None, kept_ref: Station | No
         return "refused, named not first" if named else "refused, unnamed", said
     if not fit.used[case.wrong]:
         worst = tower_error_mm(fit.station, named_ref or case.truth.truth)
+        if not first and fit.consensus == "agree" and tower_error_mm(
+                fit.station, kept_ref or case.truth.truth) <= FLAG_MM + slack_mm:
+            return "kept", said  # within the station's scatter: the fit's finer pruning ranks it among noisy ones
         if not first:
             return "left out, named not first", said
         return ("named", said) if worst <= named_mm else (f"named, but a tower {worst:.1f} mm off", said)

@@ -13,7 +13,9 @@ axis; every suction point moved 1-3 mm in a random direction; with probability :
 student's eye); above poses at the station's approach, 15-60 mm over their contact (each with the same noise).
 
 Files (:func:`files`): three bottom contacts (one per tower), the taught example's pattern, teach's required poses
-(the start tower's top, the others' bottom), and the full lab table's nine contacts with their above poses.
+(the start tower's top, the others' bottom), and the full lab table's nine contacts. A lab table
+(:func:`lab_table`) has them with one above pose per tower, over the top of the stack, shared by its heights (as
+students record it: the carry height clears a full stack).
 """
 
 from __future__ import annotations
@@ -124,7 +126,20 @@ def files(base: Station) -> dict[str, list[Slot]]:
     return {"bottom": [(t, 0, ON) for t in range(n_t)],
             "example": [(0, 0, ON), (1, 0, ON), (2, 0, ON), (0, 2, ON), (2, 1, ABOVE)],
             "teach": [(0, n_h - 1, ON), *((t, 0, ON) for t in range(1, n_t))],
-            "table": [(t, h, k) for t in range(n_t) for h in range(n_h) for k in (ON, ABOVE)]}
+            "table": [(t, h, ON) for t in range(n_t) for h in range(n_h)]}
+
+
+def lab_table(st: RealLike, rng: np.random.Generator) -> np.ndarray:
+    """The station's poses as a lab table (T, H, 2, 6) [rad]: its contacts, and per tower one above pose 15-60 mm
+    over the top of its stack (1-3 mm of noise), the same for every height."""
+    q, truth = st.q.copy(), st.truth
+    over = float(rng.uniform(*APPROACH_MM)) * 1e-3
+    for t in range(truth.n_towers):
+        p = contact_point_world(truth, t, truth.n_heights - 1) + np.array([0.0, 0.0, over])
+        v = rng.normal(size=3)
+        p += v / np.linalg.norm(v) * float(rng.uniform(*NOISE_MM)) * 1e-3
+        q[t, :, ABOVE] = rt.pose_q(truth, p, rt.R_tcp(truth.tool_yaw))
+    return q
 
 
 def taught(q: np.ndarray, slots: list[Slot], wrong: int = -1, q_wrong: np.ndarray | None = None) -> TaughtPoints:
@@ -171,4 +186,4 @@ def outcome(case: gm.Case) -> tuple[str, str]:
     return gm.outcome(case, named_ref=ref, kept_ref=ref, slack_mm=NOISE_MM[1], named_mm=gm.TOWER_MM + NOISE_MM[1])
 
 
-__all__ = ["RealLike", "files", "gross_cases", "outcome", "real_like", "recorded", "station", "taught"]
+__all__ = ["RealLike", "files", "gross_cases", "lab_table", "outcome", "real_like", "recorded", "station", "taught"]

@@ -220,7 +220,8 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
         model = choose_model(base, [s for s, k in zip(slots, candidates, strict=True) if k])
         assert model is not None  # its tower has another contact
         fit = robust_fit(base, model, prep.safe_slots, prep.m, candidates, tol_mm, tol_deg)
-    if c.kind in ("agree", "named") and not refused and _bends(fit, prep, agreeing):
+    if c.kind in ("agree", "named") and not refused and (_bends(fit, prep, agreeing) or _tilt_only(fit, prep,
+                                                                                                  agreeing)):
         # The finer pruning left out points that agree with the rest, and the grid moved more than the
         # always-flagged distance from them: they agree, so they all stay.
         candidates = agreeing
@@ -280,7 +281,12 @@ def _calibration_fit(ctx: _Context, station: Station, model: GridModel, candidat
     if not ctx.heads:  # when the named points had to stay in the fit, it judges the others wrongly: not shown
         is_suspect |= (~fit.used & candidates) | (severity > 1.0)
     order = sorted(np.flatnonzero(is_suspect), key=lambda i: -np.nan_to_num(severity[i], nan=np.inf))
-    order = [i for i in ctx.named if i in order] + [i for i in order if i not in ctx.named]  # the named first
+    # Those that cannot take part first (a pose 117 deg from tool down is wrong whatever the others say), then the
+    # one the consensus named, then the points the fit left out, then the rest, each worst first.
+    hard = [i for i in order if ctx.hard[i]]
+    named_first = [i for i in ctx.named if i in order and i not in hard]
+    rest = [i for i in order if i not in hard and i not in ctx.named]
+    order = hard + named_first + [i for i in rest if not fit.used[i]] + [i for i in rest if fit.used[i]]
     reasons = _reasons(ctx, [int(i) for i in order])
     suspects = tuple(
         Suspect(index=int(i), tower=points[i].tower, height=points[i].height, k=points[i].k, field=points[i].where,
@@ -327,6 +333,15 @@ def _scatter(c: Consensus, fit: RobustFit, prep: Prepared) -> bool:
     dev = np.where(fit.used & fit.removable, fit.deviation_mm, residual)
     on = prep.candidates & np.array([s[2] == ON for s in prep.safe_slots])
     return bool(np.all(dev[on] <= CONTACT_FLAG_MM))
+
+
+def _tilt_only(fit: RobustFit, prep: Prepared, candidates: BoolArray) -> bool:
+    """Whether the fit left out a contact the consensus kept for its orientation alone: its tower tilted alike on
+    every point (the student's wrist there: issue 37), which the consensus judges per tower."""
+    d = np.linalg.norm(prep.m.p_world - fit.solution.points(prep.safe_slots), axis=1) * 1e3
+    left = np.flatnonzero(candidates & ~fit.used)
+    return any(prep.safe_slots[i][2] == ON and fit.rot_deg[i] > fit.thresholds.deg and d[i] <= fit.thresholds.mm
+               for i in left)
 
 
 def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray, points: Sequence[TaughtPoint]) -> str:

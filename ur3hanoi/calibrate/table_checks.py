@@ -12,7 +12,8 @@ say holds on every station:
   joint-2/3/4 offset moves it by centimetres.
 - **the tool's axis** (:func:`tilt_checks`): a contact's suction axis within :data:`TILT_FLAG_DEG` (5 deg) of the
   other contacts of its tower; a tower's axis (all its contacts alike: how the student held the wrist there, up to
-  6.3 deg on real stations) within :data:`TOWER_TILT_DEG` (8 deg) of the other towers'. A point tilted from the
+  6.3 deg on real stations) within :data:`TOWER_TILT_DEG` (8 deg) of the nearest other tower's. A point tilted
+  from the
   others of its tower is wrong; a whole tower tilted alike is the tower's.
 - **distinct towers** (:func:`distinct_checks`): two towers' origins at least one block edge apart horizontally
   (closer, their blocks would overlap: a pose recorded for the wrong tower, or copied).
@@ -29,7 +30,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.calibrate.limits import CONTACT_FLAG_MM, TILT_FLAG_DEG, angle_deg, table_axis
+from ur3hanoi.calibrate.limits import CONTACT_FLAG_MM, TILT_FLAG_DEG, angle_deg
 
 TOWER_TILT_DEG = 8.0
 """[deg] a tower whose every contact is tilted alike stands tilted (the student's wrist, a block set askew): its
@@ -42,9 +43,10 @@ def _unit(v: FloatArray) -> FloatArray:
 
 
 def level_checks(origins_m: FloatArray, judged: Sequence[int]) -> list[tuple[int, float]]:
-    """Each ``judged`` tower's origin height [mm] from the median of the other towers' (``origins_m`` (T, 3) [m], NaN
-    rows: no contact): (tower, signed difference [mm], positive: higher)."""
-    present = [t for t in range(len(origins_m)) if not np.isnan(origins_m[t, 0])]
+    """Each ``judged`` tower's origin height [mm] from the median of the other judged towers' (``origins_m`` (T, 3)
+    [m], NaN rows: no contact; a tower not judged, vouched for, is no reference either): (tower, signed difference
+    [mm], positive: higher)."""
+    present = [t for t in judged if not np.isnan(origins_m[t, 0])]
     out = []
     for t in judged:
         others = [o for o in present if o != t]
@@ -55,8 +57,8 @@ def level_checks(origins_m: FloatArray, judged: Sequence[int]) -> list[tuple[int
 
 def tilt_checks(axes: FloatArray, towers: Sequence[int]) -> tuple[list[tuple[int, float]], list[tuple[int, float]]]:
     """The tool's axis of contacts ``axes`` (N, 3) on ``towers`` (N,): (point, deg from the other contacts of its
-    tower) for points with such mates; (tower, deg of its mean axis from the other towers') for every tower with
-    another beside it."""
+    tower) for points with such mates; (tower, deg of its mean axis from the nearest other tower's) for every tower
+    with another beside it."""
     axes = np.asarray(axes, dtype=float).reshape(-1, 3)
     tw = np.asarray(towers, dtype=int)
     points, lean = [], []
@@ -64,11 +66,11 @@ def tilt_checks(axes: FloatArray, towers: Sequence[int]) -> tuple[list[tuple[int
         mates = (tw == tw[j]) & (np.arange(len(axes)) != j)
         if mates.any():
             points.append((j, float(angle_deg(axes[j:j + 1], _unit(axes[mates].mean(axis=0)))[0])))
-    for t in sorted(set(tw.tolist())):
-        others = axes[tw != t]
-        if len(others):
-            ref = table_axis(others) if len(others) >= 3 else _unit(others.mean(axis=0))
-            lean.append((t, float(angle_deg(_unit(axes[tw == t].mean(axis=0))[None, :], ref)[0])))
+    own = {t: _unit(axes[tw == t].mean(axis=0)) for t in sorted(set(tw.tolist()))}
+    for t, a in own.items():  # from the nearest other tower: one tilted tower does not make a third one lean
+        others = [b for u, b in own.items() if u != t]
+        if others:
+            lean.append((t, float(np.min(angle_deg(np.array(others), a)))))
     return points, lean
 
 
