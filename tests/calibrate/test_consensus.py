@@ -16,8 +16,8 @@ from tests.support import recorded_tables as rt
 from ur3hanoi.calibrate.consensus import AMBIGUOUS_SCORE, consensus
 from ur3hanoi.calibrate.grid_fit import measure
 from ur3hanoi.station.calibration import Station, load_station
-from ur3hanoi.tables.ik_table import generate_table
 from ur3hanoi.station.grid import contact_point_world
+from ur3hanoi.tables.ik_table import generate_table
 from ur3hanoi.teach.jog import Jogger
 
 TRUTHS = {t.name: t for t in gm.truths()}

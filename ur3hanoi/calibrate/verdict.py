@@ -45,6 +45,10 @@ from ur3hanoi.station.grid import ABOVE, ON, pose_label
 HOME_DEG = 1.0
 """[deg] a pose whose every joint is this close to the base's home pose was recorded with the arm at home."""
 
+LEVEL_TYPO_DEG = 1.0
+"""[deg] a typo in one joint explains a tower's only contact when the change leaves its axis within this of the
+others' (or a quarter of its tilt before): its place along the table gives no other check."""
+
 Points = Sequence[TaughtPoint]
 
 
@@ -87,6 +91,11 @@ def _typo(ev: Evidence, p: TaughtPoint, i: int, target: np.ndarray, axis: np.nda
     if level:
         typo = joint_typo_level(robot, ev.base.T_world_base, p.q, float(target[2]), axis, CONTACT_OK_MM, TILT_OK_DEG)
         err = abs(float(ev.m.p_world[i, 2] - target[2])) * 1e3
+        # Only its height and axis say anything: the change must bring the axis back too, not tilt it to reach the
+        # level (a pose hovering over its block is no typo of joint 2).
+        before = math.degrees(math.acos(float(np.clip(ev.m.R_world[i, :, 2] @ axis, -1.0, 1.0))))
+        if typo is not None and typo.residual_deg > max(LEVEL_TYPO_DEG, TYPO_SHARE * before):
+            return None
     else:
         typo = joint_typo_point(robot, ev.base.T_world_base, p.q, target, axis, CONTACT_OK_MM, TILT_OK_DEG)
         err = float(np.linalg.norm(ev.m.p_world[i] - target)) * 1e3
@@ -266,5 +275,5 @@ def note_lines(points: Points, accepted: Sequence[tuple[int, float]], single_pos
     return [*accepted_lines(points, accepted, base_label), *single_pose_lines(points, single_pose)]
 
 
-__all__ = ["HOME_DEG", "Named", "accept_option", "accepted_lines", "diagnose_named", "named_text", "note_lines",
-           "refusal", "single_pose_lines", "slot_text", "unexplained", "where_text"]
+__all__ = ["HOME_DEG", "LEVEL_TYPO_DEG", "Named", "accept_option", "accepted_lines", "diagnose_named", "named_text",
+           "note_lines", "refusal", "single_pose_lines", "slot_text", "unexplained", "where_text"]
