@@ -160,7 +160,7 @@ def test_a_tower_tilted_alike_is_the_tower_s_a_single_tilted_point_is_wrong(hidd
     qs = []
     for t, h, k in slots:
         p = contact_point_world(hidden, t, h)
-        qs.append(rt.pose_q(hidden, p, rt.R_tcp(hidden.tool_yaw, 6.5 if t == 2 else 0.0, 0.7)) if t == 2 else q[t, h, k])
+        qs.append(rt.pose_q(hidden, p, rt.R_tcp(hidden.tool_yaw, 6.5, 0.7)) if t == 2 else q[t, h, k])
     c = consensus(base, slots, measure(base, qs), np.ones(9, dtype=bool))
     assert c.kind == "agree", [ch for ch in c.whole.checks if ch.over]
     one = list(qs)
