@@ -19,12 +19,14 @@ def add(sub: argparse._SubParsersAction) -> None:
                                    "everything else comes from --base. A gross error (the home pose, a pose in "
                                    "the wrong slot, a typo in one joint, copied entries) is found by what explains "
                                    "the most: the point whose removal leaves the others consistent with each "
-                                   "other, the block size and the base's layout; it is named and left out. When it "
-                                   "is its tower's only contact, or the points cannot tell which of two is wrong, "
-                                   "nothing is written (exit 2) and the message says which and what to do. The "
-                                   "report gives every point's deviation [mm] and the suspects worst first. Towers "
-                                   "and heights are numbered from 1. See `ur3hanoi.calibrate.taught` for the file "
-                                   "format.")
+                                   "other, one flat table, the block size and the tool pointing down; it is named "
+                                   "and left out. When it is its tower's only contact, or the points cannot tell "
+                                   "which of two is wrong, nothing is written (exit 2) and the message says which "
+                                   "and what to do. The towers stand wherever the points put them; a tower taught "
+                                   "at one pose is written, and the output says that nothing checks where it "
+                                   "stands along the table. The report gives every point's deviation [mm] and the "
+                                   "suspects worst first. Towers and heights are numbered from 1. See "
+                                   "`ur3hanoi.calibrate.taught` for the file format.")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--taught", metavar="FILE", help="taught-points YAML (units: deg|rad; points: [...])")
     src.add_argument("--from-table", metavar="FILE", help="lab-format table whose entries are the taught points")
