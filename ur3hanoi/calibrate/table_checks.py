@@ -30,6 +30,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
+from ur3hanoi.calibrate.grid_fit import BoolArray
 from ur3hanoi.calibrate.limits import CONTACT_FLAG_MM, TILT_FLAG_DEG, angle_deg
 
 TOWER_TILT_DEG = 8.0
@@ -87,7 +88,7 @@ def share(value: float, limit: float) -> float:
     return abs(value) / limit
 
 
-def single_pose_towers(slots: Sequence[tuple[int, int, int]], used: Sequence[bool]) -> dict[int, int]:
+def single_pose_towers(slots: Sequence[tuple[int, int, int]], used: Sequence[bool] | BoolArray) -> dict[int, int]:
     """The towers whose place rests on one pose of the points ``used``: tower -> the index of that pose (a contact:
     an above pose alone does not place a tower). A second contact or an above pose over its tower checks it."""
     per: dict[int, list[int]] = {}
