@@ -53,7 +53,11 @@ def test_one_gross_error_is_named_and_left_out_or_nothing_is_written(name: str) 
 def test_the_whole_matrix(name: str) -> None:
     """Every file (3 to 9 points), every slot, every error."""
     counts = check_cases(list(gm.cases(TRUTHS[name])))
-    assert counts["named"] + counts["refused"] + counts["undecided"] >= 0.9 * sum(counts.values()), counts
+    # Issue 37: an error that moves a tower taught once along the table only is written and said (on the flat
+    # lab_sim a slot one height off is such a move too): never more than a tenth of the cases.
+    total = sum(counts.values())
+    assert counts["named"] + counts["refused"] + counts["undecided"] + counts["said"] >= 0.9 * total, counts
+    assert counts["said"] <= 0.11 * total, counts
 
 
 def test_the_matrix_is_the_issue_s_cases() -> None:

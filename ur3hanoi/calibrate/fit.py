@@ -37,7 +37,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.calibrate.consensus import Consensus
+from ur3hanoi.calibrate.consensus import SCATTER_SHARE, Consensus
 from ur3hanoi.calibrate.evidence import judge
 from ur3hanoi.calibrate.explain import diagnose
 from ur3hanoi.calibrate.grid_fit import (
@@ -324,11 +324,13 @@ def _bends(fit: RobustFit, prep: Prepared, candidates: BoolArray) -> bool:
 def _scatter(c: Consensus, fit: RobustFit, prep: Prepared) -> bool:
     """Whether what the consensus could not pin on one point is the station's scatter, as the audit judges it
     (``check-table --fit`` calls such a table clean, and the two must agree): only contacts the others check were
-    off, and the robust fit leaves every contact within the always-flagged distance (a contact it left out: of the
-    grid fitted without it)."""
+    off, each at most :data:`~ur3hanoi.calibrate.consensus.SCATTER_SHARE` of the always-flagged distance, or the
+    robust fit leaves every contact within it (a contact it left out: of the grid fitted without it)."""
     over = [ch for ch in c.whole.checks if ch.over and not ch.soft]
     if not over or any(ch.what != "point" for ch in over):
         return False
+    if all(ch.share <= SCATTER_SHARE for ch in over):  # contacts up to 12 mm off the others' grid: real scatter
+        return True
     residual = np.linalg.norm(prep.m.p_world - fit.solution.points(prep.safe_slots), axis=1) * 1e3
     dev = np.where(fit.used & fit.removable, fit.deviation_mm, residual)
     on = prep.candidates & np.array([s[2] == ON for s in prep.safe_slots])
