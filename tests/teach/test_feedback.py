@@ -129,12 +129,15 @@ def test_a_pose_recorded_in_the_wrong_slot_says_which_slot(base: Station, hidden
 
 
 def test_two_points_the_evidence_cannot_tell_apart_are_both_named(base: Station, hidden: Station) -> None:
-    fb = feedback(base, taught(hidden, ALL_CHECKED, {1: (5.0, 0.0, 0.0), 4: (-6.0, 0.0, 0.0)}), "lab_real")
+    fb = feedback(base, taught(hidden, ALL_CHECKED, {1: (7.0, 0.0, 0.0), 4: (-8.0, 0.0, 0.0)}), "lab_real")
     assert len(fb.suspects) == 1 and fb.rows[1].suspect and fb.rows[4].suspect
     line = fb.suspects[0][1]
     assert line.startswith("the points cannot tell which of ") and "tower 2 height 1 [points[1]]" in line
     assert "tower 2 height 3 [points[4]]" in line and "teach another height of tower 2" in line
     assert fb.fit is not None and not fb.fit.sound
+    # 11 mm apart: the station's scatter (issue 37), as f and calibrate judge it.
+    fb = feedback(base, taught(hidden, ALL_CHECKED, {1: (5.0, 0.0, 0.0), 4: (-6.0, 0.0, 0.0)}), "lab_real")
+    assert fb.fit is not None and fb.fit.sound and not any(r.suspect for r in fb.rows[:3])
 
 
 def test_too_few_towers_says_why_there_is_no_calibration_yet(base: Station, hidden: Station) -> None:

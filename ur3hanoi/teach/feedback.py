@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ur3hanoi.calibrate import CalibrationFit, fit_station
 from ur3hanoi.calibrate.evidence import BY_LEVEL as LEVEL
@@ -110,6 +110,8 @@ def feedback(base: Station, taught: TaughtPoints, base_label: str, accept: Colle
         problem = fit.problem
     except TaughtPointsError as exc:
         problem = str(exc).split(": ", 1)[-1]
+    if fit is not None and fit.consensus == "agree" and c.kind in ("undecided", "unexplained"):
+        c = replace(c, kind="agree", wrong=(), alone=False, chosen=c.whole)  # the station's scatter, as f judges it
     judged = c.chosen
     suspects: list[tuple[int, str]] = []
     if c.kind == "named":
