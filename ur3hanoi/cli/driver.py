@@ -15,7 +15,7 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from ur3hanoi.cli.options import DRIVER_WAIT, SPEED_SLIDER, option
+from ur3hanoi.cli.options import DRIVER_WAIT, SIM_TIME, SPEED_SLIDER, option
 
 if TYPE_CHECKING:
     from ur3hanoi.cli.remote import SolveJob
@@ -36,6 +36,13 @@ def add_driver_option(p: argparse.ArgumentParser, station: bool) -> None:
         p.add_argument("--speed-scaling", type=option(SPEED_SLIDER), default=1.0, metavar="F",
                        help="with --driver ur: the pendant's speed slider, a fraction in (0, 1] (default 1): the "
                             "trajectory controller's time runs this much slower")
+        p.add_argument("--program-stop-at", type=option(SIM_TIME), default=None, metavar="S",
+                       help="with --driver ur, fault injection: the External Control program stops S seconds after "
+                            "the station starts (0: stopped from the start), as the pendant's stop button does: "
+                            "robot_program_running turns false, the running goal ends, new goals are refused")
+        p.add_argument("--program-resume-at", type=option(SIM_TIME), default=None, metavar="S",
+                       help="with --driver ur and --program-stop-at: the program runs again S seconds after the "
+                            "station starts (the pendant's play button)")
     else:
         p.add_argument("--far-start", choices=("approach", "refuse"), default="approach",
                        help="with --driver ur, an arm far from where the plan starts: approach = move it there "
@@ -43,6 +50,20 @@ def add_driver_option(p: argparse.ArgumentParser, station: bool) -> None:
         p.add_argument("--wait", type=option(DRIVER_WAIT), default=15.0, metavar="S",
                        help="with --driver ur: wait at most S seconds for the driver's joint states, io_states, "
                             "action server and set_io (default 15)")
+
+
+def program_options(args: argparse.Namespace) -> dict[str, float | None]:
+    """``--program-stop-at`` / ``--program-resume-at`` as station options (one line when they contradict)."""
+    from ur3hanoi.errors import InputError
+
+    stop, resume = args.program_stop_at, args.program_resume_at
+    if resume is not None and (stop is None or resume <= stop):
+        raise InputError(f"--program-resume-at {resume:g} needs an earlier --program-stop-at (got "
+                         f"{'none' if stop is None else f'{stop:g}'}): the program can only start again after it "
+                         "stopped")
+    if stop is not None and args.driver != "ur":
+        raise InputError("--program-stop-at needs --driver ur (the course's topics have no robot program)")
+    return {"program_stop_at_s": stop, "program_resume_at_s": resume}
 
 
 def driver_plan(args: argparse.Namespace, job: SolveJob, default_calibration: str) -> Plan:

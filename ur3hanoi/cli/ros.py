@@ -77,7 +77,7 @@ def _node(args: argparse.Namespace, report_file: Path | None) -> RosServer:
         from ur3hanoi.interface.ros1.ur_server import RosDriverOptions, RosDriverServer
 
         return RosDriverServer(RosDriverOptions(**fields, master_uri=args.master, host=args.host,
-                                                speed_scaling=args.speed_scaling))
+                                                speed_scaling=args.speed_scaling, **driver.program_options(args)))
     return RosServer(RosServerOptions(**fields, master_uri=args.master, host=args.host))
 
 

@@ -103,7 +103,7 @@ def _run_station(args: argparse.Namespace) -> int:
 
         report = Ros2DriverStation(Ros2DriverOptions(**fields, speed_scaling=args.speed_scaling,
                                                      distro=_distro(args), network=args.network,
-                                                     domain_id=args.domain_id)).run()
+                                                     domain_id=args.domain_id, **driver.program_options(args))).run()
     else:
         from ur3hanoi.interface.ros2.server import Ros2Server, Ros2ServerOptions
 

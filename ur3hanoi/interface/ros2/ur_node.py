@@ -45,6 +45,7 @@ class Served(Protocol):
     def on_spawn(self, tower: Any) -> None: ...
     def on_remove(self, block: Any) -> None: ...
     def on_hold(self, seconds: float) -> None: ...
+    def on_program(self, running: bool) -> None: ...
 
 
 JOINT_STATE_ORDER = ROS1_JOINT_STATE_ORDER
@@ -99,6 +100,13 @@ class DriverNode:
             self.pub_joints = node.create_publisher(sensor_msgs.JointState, names.joint_states, 10)
             self.pub_io = node.create_publisher(ur_msg.IOStates, names.io_states, 10)
             self.pub_scaling = node.create_publisher(std_msgs.Float64, names.speed_scaling, 10)
+            # Latched as the GPIO controller's (gpio_controller.cpp @ a16a268 lines 249-266: SystemDefaultsQoS,
+            # transient_local): a client that connects later still gets the program's state.
+            from rclpy.qos import DurabilityPolicy, QoSProfile
+
+            latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+            self.pub_program = node.create_publisher(std_msgs.Bool, names.program_running, latched)
+            self._program: bool | None = None
 
             def goal_cb(request: Any) -> Any:
                 ok = station.goal_callback(request, self._now())
@@ -128,6 +136,8 @@ class DriverNode:
                                      lambda m: station.on_remove(int(m.data)), 10)
             node.create_subscription(std_msgs.Float64, "ur3hanoi/hold_arm",
                                      lambda m: station.on_hold(float(m.data)), 10)
+            node.create_subscription(std_msgs.Bool, "ur3hanoi/program_running",
+                                     lambda m: station.on_program(bool(m.data)), 10)
             self.executor = MultiThreadedExecutor(num_threads=_THREADS, context=self.context)
             self.executor.add_node(node)
             self.thread = threading.Thread(target=self.executor.spin, name="rclpy-executor", daemon=True)
@@ -155,6 +165,9 @@ class DriverNode:
         js.effort = [float(out.effort[i]) for i in self._order]
         self.pub_joints.publish(js)
         self.pub_io.publish(self._io.update(out.io))
+        if out.program_running != self._program:
+            self._program = out.program_running
+            self.pub_program.publish(self.std_msgs.Bool(data=out.program_running))
         now = time.monotonic()
         if now >= self._next_scaling:
             self._next_scaling = now + 1.0 / SPEED_SCALING_HZ

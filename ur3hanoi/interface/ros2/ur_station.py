@@ -16,7 +16,12 @@ What a client of ``ur_robot_driver`` finds (:mod:`ur3hanoi.interface.ros2.ur_dri
   up to 10 times as the driver's GPIO controller does (``false`` after that, or for a request the driver refuses);
   ``/io_and_status_controller/io_states`` (``ur_msgs/msg/IOStates``, every cycle), with the suction model's feedback
   on the calibration's pins;
-- ``/speed_scaling_state_broadcaster/speed_scaling`` (``std_msgs/msg/Float64``, **percent**, 100 Hz).
+- ``/speed_scaling_state_broadcaster/speed_scaling`` (``std_msgs/msg/Float64``, **percent**, 100 Hz);
+- ``/io_and_status_controller/robot_program_running`` (``std_msgs/msg/Bool``, transient local, on change). While the
+  External Control program is stopped (``--program-stop-at`` .. ``--program-resume-at``) the trajectory controller
+  is inactive, as the driver's ``controller_stopper`` leaves it: the running goal is aborted (INVALID_GOAL, "Current
+  goal cancelled during deactivate transition."), new goals are rejected at send_goal ("Can't accept new action
+  goals. Controller is not running." in the log).
 
 Besides: ``ur3hanoi/spawn`` and ``ur3hanoi/remove_block`` (``std_msgs/Int32``) as on the course station, and
 ``ur3hanoi/hold_arm`` (``std_msgs/Float64`` seconds: the arm is held, e.g. to provoke a path-tolerance abort).
@@ -41,6 +46,7 @@ from ur3hanoi.interface.ros2.ur_driver import goal_from_msg, names_for, preempte
 from ur3hanoi.interface.urdriver.facts import ErrorCode
 from ur3hanoi.interface.urdriver.follower import Outcome
 from ur3hanoi.interface.urdriver.goal import check_goal
+from ur3hanoi.interface.urdriver.profile import NOT_RUNNING
 from ur3hanoi.interface.urdriver.station import DriverStation, DriverStationOptions
 
 READY_LINE = "ur3hanoi ros2-station: ready"
@@ -116,9 +122,10 @@ class Ros2DriverStation(DriverStation):
         """Accept (True) or reject at send_goal (False, the reason logged) as ``validate_trajectory_msg`` does."""
         goal = goal_from_msg(request, now_s)
         why = check_goal(goal, self.options.profile)
-        if why is not None:
+        reason = NOT_RUNNING if not self.output.program_running else None if why is None else why.reason
+        if reason is not None:
             self.rejected_at_send_goal += 1
-            self.log.log(self.TOPIC_LOG["goal"], "error", f"goal rejected at send_goal: {why.reason}")
+            self.log.log(self.TOPIC_LOG["goal"], "error", f"goal rejected at send_goal: {reason}")
             return False
         return True
 

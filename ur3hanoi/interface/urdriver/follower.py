@@ -23,6 +23,9 @@ its :class:`~ur3hanoi.interface.urdriver.profile.ControllerProfile`.
 - **Cancel** (:meth:`TrajectoryFollower.cancel`) ends the active goal and ramps the desired state to rest: the
   controller's stop trajectory (``stop_trajectory_duration``, a quintic from the current desired position and
   velocity), lengthened where a joint would decelerate faster than its acceleration limit allows; then it holds.
+- **ROS 2** (``from_measured``): a new goal starts at its first sample from the *measured* state, every point kept
+  (a point at 0 s is commanded at once); an abort or a cancel holds the measured position (``set_hold_position``).
+- **The robot program** (:meth:`TrajectoryFollower.set_running`): see there.
 
 The results are read with :meth:`TrajectoryFollower.take_outcomes`. Nothing here knows ROS, threads or MuJoCo.
 """
@@ -39,7 +42,7 @@ import numpy.typing as npt
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ErrorCode
 from ur3hanoi.interface.urdriver.goal import Rejection, TrajectoryGoal, TrajectoryPoint, check_goal
-from ur3hanoi.interface.urdriver.profile import ControllerProfile
+from ur3hanoi.interface.urdriver.profile import NOT_RUNNING, ControllerProfile
 from ur3hanoi.interface.urdriver.spline import JointState, Segment, find_segment, segment
 
 Status = Literal["succeeded", "aborted", "preempted", "canceled"]
@@ -137,6 +140,9 @@ class TrajectoryFollower:
         self._outcomes: list[Outcome] = []
         self._feedback: Feedback | None = None
         self.running = True
+        self._measured = q.copy()  # the last cycle's measured position [rad] (ROS 2's ``state_current_``)
+        self._bridge: tuple[float, JointState] | None = None  # ROS 2: a new goal's first point, bridged at 1st sample
+        self._first_sample = False
 
     # ------------------------------------------------------------------------------------------------ goals
     def _tolerances(self, goal: TrajectoryGoal) -> _Tolerances:
@@ -166,12 +172,14 @@ class TrajectoryFollower:
     def submit(self, key: Hashable, goal: TrajectoryGoal) -> Rejection | None:
         """Accept ``goal`` (it preempts the active one) or say why not. It starts at the next :meth:`update`."""
         if not self.running:
-            text = "Can't accept new commands. Controller is not running."
-            return Rejection(ErrorCode.INVALID_GOAL, text, text)
+            return Rejection(ErrorCode.INVALID_GOAL, "", NOT_RUNNING)
         rejection = check_goal(goal, self.profile, self.joints)
         if rejection is not None:
             return rejection
         now = self.uptime + self._last_period  # the next update's controller time
+        if self.profile.from_measured and goal.points:
+            self._submit_from_measured(key, goal, now)
+            return None
         if not goal.points:
             self._preempt()
             self.active = _Active(key, self._tolerances(goal), now, self.cycle, np.zeros(self.n, dtype=bool))
@@ -198,26 +206,64 @@ class TrajectoryFollower:
         self.active = _Active(key, self._tolerances(goal), times[-1], self.cycle, np.zeros(self.n, dtype=bool))
         return None
 
+    def _submit_from_measured(self, key: Hashable, goal: TrajectoryGoal, now: float) -> None:
+        """ROS 2: the trajectory from the goal's points as they are (the controller's ``Trajectory::sample`` drops
+        none); the segment from the measured state to the first point is made at the first sample (:meth:`update`),
+        from where the arm is then (``set_point_before_trajectory_msg(time, state_current_)``)."""
+        start = now + (goal.start_in_s or 0.0)
+        times = [start + p.time_from_start_s for p in goal.points]
+        order = [goal.joint_names.index(j) for j in self.joints]
+        states = [self._point(p, order) for p in goal.points]
+        if len(states) == 1:
+            new = [segment(times[0], states[0], times[0], states[0])]
+        else:
+            new = [segment(times[k], states[k], times[k + 1], states[k + 1]) for k in range(len(states) - 1)]
+        self._preempt()
+        self.trajectory = new
+        self._bridge = (times[0], states[0])
+        self.active = _Active(key, self._tolerances(goal), times[-1], self.cycle, np.zeros(self.n, dtype=bool))
+
     def _preempt(self) -> None:
         if self.active is not None:
             self._end("preempted", ErrorCode.SUCCESSFUL, "")
 
     def set_running(self, running: bool) -> None:
         """Start or stop the controller (the driver's ``controller_stopper`` while the robot program is stopped on
-        the pendant): stopping preempts the active goal and brings the arm to rest; a stopped controller refuses
-        goals (INVALID_GOAL "Can't accept new commands. Controller is not running.")."""
-        if self.running and not running:
-            self._preempt()
-            self._stop(self.uptime)
+        the pendant). Stopping ends the active goal (ROS 2: aborted, INVALID_GOAL and the profile's
+        ``deactivated_text``; ROS 1: preempted) and the arm stops where it is; a stopped controller refuses goals
+        (INVALID_GOAL without an ``error_string``). Starting holds the measured position (ROS 1 ``starting``, ROS 2
+        ``on_activate``: ``set_hold_position``)."""
+        if self.running and not running and self.active is not None:
+            if self.profile.deactivated_text:
+                self._end("aborted", ErrorCode.INVALID_GOAL, self.profile.deactivated_text)
+            else:
+                self._preempt()
+        if running != self.running:
+            self._hold_measured()
         self.running = running
 
     def cancel(self, key: Hashable) -> bool:
-        """Cancel goal ``key`` if it is the active one (True): it ends "canceled" and the arm ramps to rest."""
+        """Cancel goal ``key`` if it is the active one (True): it ends "canceled" and the arm ramps to rest (ROS 2:
+        holds the measured position)."""
         if self.active is None or self.active.key != key:
             return False
         self._end("canceled", ErrorCode.SUCCESSFUL, "")
-        self._stop(self.uptime)
+        self._halt()
         return True
+
+    def _halt(self) -> None:
+        """After a cancel or an abort: ROS 2 holds the measured position, ROS 1 ramps the desired state to rest."""
+        if self.profile.from_measured:
+            self._hold_measured()
+        else:
+            self._stop(self.uptime)
+
+    def _hold_measured(self) -> None:
+        """Hold the last cycle's measured position (``set_hold_position``: ``state_current_.positions``)."""
+        z = np.zeros(self.n)
+        here = JointState(self._measured.copy(), z, z)
+        self._bridge = None
+        self.trajectory = [segment(self.uptime, here, self.uptime, here)]
 
     def _end(self, status: Status, code: ErrorCode, text: str) -> None:
         assert self.active is not None
@@ -247,6 +293,13 @@ class TrajectoryFollower:
         self._last_period = period_s * scaling
         t = self.uptime + (period_s if self.profile.sample_one_period_ahead else self._last_period)
         self.uptime += self._last_period
+        self._first_sample = self._bridge is not None
+        if self._bridge is not None:
+            t_first, first = self._bridge
+            self._bridge = None
+            if t_first > t + TIME_RESOLUTION_S:
+                self.trajectory.insert(0, segment(t, JointState(q.copy(), qd.copy(), None), t_first, first))
+        self._measured = q.copy()
         index = find_segment(self.trajectory, t)
         seg = self.trajectory[index]
         p, v, a = seg.sample(t)
@@ -261,14 +314,17 @@ class TrajectoryFollower:
 
     def _check(self, active: _Active, seg: Segment, last: bool, err_q: FloatArray, err_qd: FloatArray) -> None:
         tol, prof = active.tolerances, self.profile
-        if self.uptime < seg.end_s - TIME_RESOLUTION_S:
+        moving = self.uptime < seg.end_s - TIME_RESOLUTION_S
+        if moving or self._first_sample:  # ROS 2 checks the first sample even when it is the last point
             active.max_path_error = max(active.max_path_error, float(np.abs(err_q).max()))
             bad = _outside(err_q, err_qd, tol.bounds[0], tol.bounds[1])
             if bad is not None:
                 self._end("aborted", ErrorCode.PATH_TOLERANCE_VIOLATED,
                           prof.path_error.format(joint=self.joints[bad], error=float(err_q[bad]), late=0.0))
                 if prof.hold_on_path_abort:
-                    self._stop(self.uptime)
+                    self._halt()
+                return
+        if moving:
             return
         if not last:
             return
@@ -295,7 +351,7 @@ class TrajectoryFollower:
         self._end("aborted", ErrorCode.GOAL_TOLERANCE_VIOLATED,
                   prof.goal_error.format(joint=self.joints[joint], error=float(err_q[joint]), late=late))
         if prof.hold_on_path_abort:
-            self._stop(self.uptime)
+            self._halt()
 
     # ------------------------------------------------------------------------------------------- reading
     def feedback(self) -> Feedback | None:

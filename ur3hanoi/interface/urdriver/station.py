@@ -45,11 +45,15 @@ class DriverStationOptions(ServerOptions):
     Attributes:
         speed_scaling: the pendant's speed slider, in (0, 1].
         profile: the controller's defaults and rules (ROS 1 or ROS 2).
+        program_stop_at_s, program_resume_at_s: fault injection: the External Control program stops (as when the
+            pendant's stop button is pressed) and starts again at these world times [s] (None: never).
     """
 
     rate_hz: float | None = None
     speed_scaling: float = 1.0
     profile: ControllerProfile = ROS1_SCALED
+    program_stop_at_s: float | None = None
+    program_resume_at_s: float | None = None
 
 
 @dataclass(frozen=True)
@@ -64,6 +68,7 @@ class CycleOutput:
         decisions: goals decided this cycle: (key, None = accepted, or the rejection).
         feedback: the active goal's (key, feedback), or None.
         results: goals that ended this cycle: (key, outcome).
+        program_running: whether the External Control program runs (the driver's ``robot_program_running``).
     """
 
     t_s: float
@@ -76,6 +81,7 @@ class CycleOutput:
     decisions: tuple[tuple[Hashable, Rejection | None], ...] = ()
     feedback: tuple[Hashable, Feedback] | None = None
     results: tuple[tuple[Hashable, Outcome], ...] = ()
+    program_running: bool = True
 
 
 class DriverStation(ServerCore["ServoWorld"]):
@@ -96,6 +102,9 @@ class DriverStation(ServerCore["ServoWorld"]):
         self._decisions: list[tuple[Hashable, Rejection | None]] = []
         self._switch = False
         self._effort_ids = w.servo.act_ids
+        self._program_done: set[float] = set()
+        if options.program_stop_at_s is not None and options.program_stop_at_s <= 0.0:
+            self._scheduled_program()  # stopped from the start: the first output says so
         self.output = self._output((), None, ())
 
     def _build_world(self, config: SimConfig, n_blocks: int) -> ServoWorld:
@@ -151,14 +160,32 @@ class DriverStation(ServerCore["ServoWorld"]):
         elif kind == "io":
             self.records.io_call(t, *payload)
         elif kind == "program":
-            self.follower.set_running(payload)
-            self.log.log(self.TOPIC_LOG[kind], "warn", f"the robot program {'runs' if payload else 'stopped'}")
+            self._set_program(bool(payload))
         else:
             super()._handle(kind, payload)
+
+    def _set_program(self, running: bool) -> None:
+        """The External Control program stops or starts: the trajectory controller with it (the driver's
+        ``controller_stopper``); ``io_states`` and the joint states go on."""
+        if running == self.follower.running:
+            return
+        self.follower.set_running(running)
+        self.records.program_changed(self.world.time, running)
+        self.log.log(self.TOPIC_LOG["program"], "warn", "the External Control program runs again" if running else
+                     "the External Control program stopped: the trajectory controller is stopped, goals are refused")
+
+    def _scheduled_program(self) -> None:
+        """``--program-stop-at`` / ``--program-resume-at``: each once, when the world time reaches it."""
+        opts, t = self.options, self.world.time
+        for at, running in ((opts.program_stop_at_s, False), (opts.program_resume_at_s, True)):
+            if at is not None and at not in self._program_done and t >= at - 1e-9:
+                self._program_done.add(at)
+                self._set_program(running)
 
     # ------------------------------------------------------------------------------------------------ cycle
     def _step(self) -> None:
         """One control cycle: the IO writes, the controller, the robot, the feedback on the inputs."""
+        self._scheduled_program()
         w, period = self.world, self.world.config.period_s
         self.io.cycle()
         wiring = self.station.wiring
@@ -191,7 +218,7 @@ class DriverStation(ServerCore["ServoWorld"]):
         w = self.world
         effort = w.scene.data.actuator_force[self._effort_ids]  # a copy (fancy indexing)
         return CycleOutput(w.time, CONTROLLER_JOINTS, w.q, w.qd, effort, self.io.states, w.speed_scaling, decisions,
-                           feedback, results)
+                           feedback, results, self.follower.running)
 
     # ------------------------------------------------------------------------------------------------ report
     def _report_motion(self) -> dict[str, Any]:
@@ -201,7 +228,8 @@ class DriverStation(ServerCore["ServoWorld"]):
                 "goals": self.records.summary(),
                 "goal_records": [g.as_dict() for g in self.records.goals],
                 "io_calls": list(self.records.io_calls),
-                "halts": [h.as_dict() for h in self.records.halts]}
+                "halts": [h.as_dict() for h in self.records.halts],
+                "program": list(self.records.program)}
 
     def _report_final(self) -> dict[str, Any]:
         return {"goal_active": self.follower.active is not None, "program_running": self.follower.running,
