@@ -81,12 +81,12 @@ def driver_plan(args: argparse.Namespace, job: SolveJob, default_calibration: st
 def run_driver_solve_command(args: argparse.Namespace, transport: Any, make_plan: Callable[[], Plan],
                              outcome: dict[str, object]) -> int:
     """Connect ``transport`` (no driver: an error at once, before planning), plan, run the plan, print the outcome
-    (one JSON object with ``--json``); a suction fault is re-raised (exit 3) after its outcome is printed; every
-    other error propagates (exit 2)."""
+    (one JSON object with ``--json``); a suction fault or a stopped robot program is re-raised (exit 3) after its
+    outcome is printed; every other error propagates (exit 2)."""
     import json
 
     from ur3hanoi.cli.remote import say_for
-    from ur3hanoi.errors import SuctionFaultError
+    from ur3hanoi.errors import ProgramStoppedError, SuctionFaultError
     from ur3hanoi.interface.urdriver.solve import DriverSolveConfig, run_driver_solve
 
     say = say_for(args)
@@ -98,7 +98,7 @@ def run_driver_solve_command(args: argparse.Namespace, transport: Any, make_plan
         say(f"connected to the UR driver on {transport.where}: {len(plan.moves)} moves, plan {plan.duration_s:.1f} s")
         try:
             result = run_driver_solve(transport, plan, plan.station.wiring, config, log=say)
-        except SuctionFaultError as exc:
+        except (SuctionFaultError, ProgramStoppedError) as exc:
             outcome.update(status="halted", exit_code=exc.exit_code, error=str(exc))
             if args.json:
                 print(json.dumps(outcome))
