@@ -52,8 +52,8 @@ def add_driver_option(p: argparse.ArgumentParser, station: bool) -> None:
                             "action server and set_io (default 15)")
 
 
-def program_options(args: argparse.Namespace) -> dict[str, float | None]:
-    """``--program-stop-at`` / ``--program-resume-at`` as station options (one line when they contradict)."""
+def program_times(args: argparse.Namespace) -> tuple[float | None, float | None]:
+    """``--program-stop-at`` and ``--program-resume-at`` [s] (one line when they contradict)."""
     from ur3hanoi.errors import InputError
 
     stop, resume = args.program_stop_at, args.program_resume_at
@@ -63,7 +63,7 @@ def program_options(args: argparse.Namespace) -> dict[str, float | None]:
                          "stopped")
     if stop is not None and args.driver != "ur":
         raise InputError("--program-stop-at needs --driver ur (the course's topics have no robot program)")
-    return {"program_stop_at_s": stop, "program_resume_at_s": resume}
+    return stop, resume
 
 
 def driver_plan(args: argparse.Namespace, job: SolveJob, default_calibration: str) -> Plan:

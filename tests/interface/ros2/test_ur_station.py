@@ -92,7 +92,7 @@ def test_invalid_goals_are_rejected_at_send_goal(jazzy_run: tuple[dict[str, Any]
     examples, _, report = jazzy_run
     assert not examples["illegal_accepted"] and not examples["moving_end_accepted"]
     assert not examples["bad_joints_accepted"]
-    assert report["transport"]["rejected_at_send_goal"] == 3
+    assert report["transport"]["rejected_at_send_goal"] == 4  # and one while the program is stopped
 
 
 def test_preempt_cancel_and_path_abort(jazzy_run: tuple[dict[str, Any], ...]) -> None:
@@ -105,6 +105,19 @@ def test_preempt_cancel_and_path_abort(jazzy_run: tuple[dict[str, Any], ...]) ->
     assert examples["violation"] == {"status": "ABORTED", "error_code": -4,
                                      "error_string": "Aborted due to path tolerance violation"}, examples
     assert examples["stop_after_abort_s"] < 1.5 and examples["drift_after_abort"] < 5e-3, examples  # stops, holds
+
+
+def test_a_stopped_program_ends_the_goal_and_refuses_new_ones_and_the_state_is_latched(
+        jazzy_run: tuple[dict[str, Any], ...]) -> None:
+    examples, _, report = jazzy_run
+    assert examples["program_at_start"] is True and examples["program_after_stop"] is False, examples
+    assert examples["stopped_goal"] == {"status": "ABORTED", "error_code": -1, "error_string":
+                                        "Current goal cancelled during deactivate transition."}, examples
+    assert examples["late_subscriber"] is False  # transient local: a client that connects later hears it too
+    assert not examples["accepted_while_stopped"] and examples["states_while_stopped"]
+    assert examples["program_after_resume"] is True
+    assert examples["t0_point_accepted"] and examples["t0_point"]["status"] == "SUCCEEDED", examples
+    assert [e["running"] for e in report["program"]] == [False, True]
 
 
 def test_set_io_returns_once_the_output_changed(jazzy_run: tuple[dict[str, Any], ...]) -> None:
