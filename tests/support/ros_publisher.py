@@ -3,7 +3,8 @@
 Usage:
 
 - ``python tests/support/ros_publisher.py JSON`` with JSON a list of ``[topic, type, fields]``, type one of ``command``
-  (ur3_driver/command), ``Int32`` (std_msgs/Int32), ``Bool`` (std_msgs/Bool) or ``String`` (std_msgs/String, a wrong type for
+  (ur3_driver/command), ``Int32`` (std_msgs/Int32), ``Bool`` (std_msgs/Bool) or ``String`` (std_msgs/String, a
+  wrong type for
   /ur3/command). Waits for a subscriber on every topic first (rospy drops messages published before that), sends
   the messages in order 50 ms apart and lets them drain before exiting.
 - ``python tests/support/ros_publisher.py --flood HZ SECONDS JSON_FIELDS``: publish the ``command`` JSON_FIELDS (a list
