@@ -43,7 +43,7 @@ import numpy as np
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import DriverError, ProgramStoppedError, SuctionFaultError
 from ur3hanoi.hanoi import Move, block_colour
-from ur3hanoi.interface.solve import describe_move
+from ur3hanoi.interface.common.moves import describe_move
 from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverTransport, GoalHandle, GoalResult
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, FUN_SET_DIGITAL_OUT, ErrorCode
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
