@@ -48,3 +48,24 @@ def test_the_controller_stopper_keeps_the_consistent_controllers_and_restores_th
     assert s[SCALED] == "inactive" and s["io_and_status_controller"] == "active" and cm.trajectory_controller() is None
     cm.program(True)
     assert states(cm)[SCALED] == "active"
+
+
+def test_ros1_load_switch_and_the_hardware_interface_refusing_while_the_program_is_stopped():
+    from ur3hanoi.interface.urdriver.controllers import Ros1ControllerManager
+
+    cm = Ros1ControllerManager()
+    assert cm.trajectory_controller() == "scaled_pos_joint_traj_controller"
+    assert cm.load("vel_joint_traj_controller") and cm.states["vel_joint_traj_controller"] == "initialized"
+    assert not cm.load("vel_joint_traj_controller") and "already loaded" in cm.last_error
+    assert not cm.switch(["pos_joint_traj_controller"], [], STRICT, True)  # both on the joints
+    assert cm.last_error == "Could not switch controllers, due to resource conflict"
+    # test_move's switch: BEST_EFFORT, stop a list of which most are not loaded or not running.
+    assert cm.switch(["pos_joint_traj_controller"], ["scaled_pos_joint_traj_controller", "twist_controller"],
+                     BEST_EFFORT, True)
+    assert cm.trajectory_controller() is None  # the stand-in serves the scaled controller's action only
+    cm.program(False)
+    assert cm.states["pos_joint_traj_controller"] == "stopped" and cm.states["joint_state_controller"] == "running"
+    assert not cm.switch(["scaled_pos_joint_traj_controller"], [], BEST_EFFORT, False)
+    assert cm.last_error.startswith("Robot control is currently inactive.")
+    cm.program(True)
+    assert cm.states["pos_joint_traj_controller"] == "running"

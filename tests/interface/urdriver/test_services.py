@@ -36,7 +36,7 @@ def test_dashboard_and_switches_drive_the_program_the_controllers_and_the_goals(
     rows = {r["name"]: r for r in controller_rows(call(st, tr, "list"))}
     assert rows[SCALED]["state"] == "active" and len(rows[SCALED]["claimed_interfaces"]) == 6
     assert call(st, tr, "switch", [PASS], [SCALED], 2) == (True, "")
-    assert st.controllers is not None and st.controllers.trajectory_controller() == PASS
+    assert st.controllers.trajectory_controller() == PASS
     r, _ = send(tr, goal(home, 1.0))  # the follower runs for the passthrough controller now
     assert r.status == "succeeded" and r.code == ErrorCode.SUCCESSFUL
-    assert st.report()["final"]["active_controllers"].count(PASS) == 1
+    assert st.report()["final"]["controllers"][PASS] == "active"
