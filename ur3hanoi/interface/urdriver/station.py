@@ -22,7 +22,7 @@ from __future__ import annotations
 import time
 from collections.abc import Hashable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.interface.common.station import ServerCore, ServerOptions
@@ -35,7 +35,6 @@ from ur3hanoi.interface.urdriver.profile import ROS1_SCALED, ControllerProfile
 from ur3hanoi.interface.urdriver.records import DriverRecords
 
 if TYPE_CHECKING:
-    from ur3hanoi.interface.urdriver.services import ServiceCall
     from ur3hanoi.sim.config import SimConfig
     from ur3hanoi.sim.servo_world import ServoWorld
 
@@ -88,6 +87,12 @@ class CycleOutput:
     feedback: tuple[Hashable, Feedback] | None = None
     results: tuple[tuple[Hashable, Outcome], ...] = ()
     program_running: bool = True
+
+
+class StationCall(Protocol):
+    """A call answered in the control thread (:class:`ur3hanoi.interface.urdriver.services.ServiceCall`)."""
+
+    def answer(self, station: DriverStation) -> None: ...
 
 
 class DriverStation(ServerCore["ServoWorld"]):
@@ -177,7 +182,7 @@ class DriverStation(ServerCore["ServoWorld"]):
         else:
             super()._handle(kind, payload)
 
-    def on_service(self, request: ServiceCall) -> None:
+    def on_service(self, request: StationCall) -> None:
         """A ``controller_manager`` or dashboard call (any thread): answered in the next control cycle."""
         self.inbox.offer("service", request)
 
