@@ -84,6 +84,7 @@ def _node(args: argparse.Namespace, report_file: Path | None) -> RosStation:
 
 
 def _run_station(args: argparse.Namespace) -> int:
+    driver.program_times(args)  # a contradiction in the program options: one line before any work
     report_file = remote.check_station_outputs(args, DEFAULT_CALIBRATION)  # before any work
     node = _node(args, report_file)
     # Standard output carries only the JSON report: whatever else writes to file descriptor 1 (rospy's info
