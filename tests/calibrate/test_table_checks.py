@@ -77,8 +77,6 @@ def test_a_real_like_station_taught_as_a_student_would_is_written(base: Station,
     # What the issue measured on the real stations: one tower far from where lab_real's layout puts it.
     for name, slots in rl.files(base).items():
         fit = fit_station(base, rl.taught(st.q, slots))
-        if name == "example" and st.odd is not None and st.odd[0] == 0:
-            continue  # tower 1's two contacts 10 mm apart: over the always-flagged 8 mm (the slow sweep asserts it)
         worst = _written(fit.sound, fit.station, st.truth)
         # Each grid point within the recording noise (3 mm), the odd contact (10 mm) and the lever of the step
         # fitted from them.
@@ -111,17 +109,14 @@ def test_every_single_gross_error_on_real_like_stations(base: Station) -> None:
 @pytest.mark.slow
 def test_the_whole_real_like_matrix(base: Station) -> None:
     """Ten stations, every file, every slot, every error; and every clean file written (the example's two tower-1
-    contacts 10 mm apart, when the odd contact is one of them: both named, nothing written)."""
+    contacts 10 mm apart when the odd contact is one of them too: the station's scatter)."""
     counts: Counter[str] = Counter()
     for seed in range(10):
         st = rl.real_like(seed, base)
         counts += check_real_like(rl.gross_cases(st, base))
         for name, slots in rl.files(base).items():
             fit = fit_station(base, rl.taught(st.q, slots))
-            if name == "example" and st.odd is not None and st.odd[0] == 0:
-                assert fit.sound or sorted(fit.named) == [0, 3], fit.problem
-            else:
-                assert fit.sound, (seed, name, fit.problem)
+            assert fit.sound, (seed, name, fit.problem)
     assert counts["named"] + counts["refused"] + counts["undecided"] >= 0.7 * sum(counts.values()), counts
 
 
