@@ -65,7 +65,7 @@ def test_ros2_solve_solves_on_the_ur3e_station_over_dds(tmp_path: Path) -> None:
     script = f"""
 $UR3HANOI ros2-station --timing honest --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 $UR3HANOI ros2-solve --start 1 --end 3 --v 4 --a 4 --json
 CODE=$?
 kill -INT $ST; wait $ST; echo "station exit $?" >&2
@@ -92,7 +92,7 @@ def test_bridge_timing_and_halt_on_a_missing_block_over_dds(tmp_path: Path) -> N
     script = f"""
 $UR3HANOI ros2-station --remove-block 3 --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 $UR3HANOI ros2-solve --start 1 --end 3 --json
 CODE=$?
 kill -INT $ST; wait $ST; echo "station exit $?" >&2
@@ -219,7 +219,7 @@ def test_absurd_commands_over_dds_are_refused_and_sigterm_stops_the_station_clea
     script = f"""
 $UR3HANOI ros2-station --timing honest --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 {PUBLISHER} '{json.dumps(bad)}' || exit 91
 kill -USR1 $ST; sleep 0.5; cp {report} {tmp_path}/snap.json
 {PUBLISHER} '{json.dumps(good)}' || exit 92
@@ -257,7 +257,7 @@ def test_a_1_khz_command_flood_over_dds_stays_bounded_and_sigint_stops_the_stati
     script = f"""
 $UR3HANOI ros2-station --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 {PUBLISHER} --flood 1000 {seconds} '{json.dumps(fields)}' || exit 91
 kill -INT $ST; wait $ST; echo "station exit $?" >&2
 """
@@ -304,7 +304,7 @@ def test_remove_block_and_spawn_over_dds_with_frames_rendered(tmp_path: Path) ->
 $UR3HANOI ros2-station --timing honest --blocks 1 --frames {frames} --report {report} \\
   > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 {PUBLISHER} --int ur3hanoi/remove_block 0 1 || exit 91
 {solve} > {tmp_path}/halt.json; echo "halt exit $?" >&2
 kill -USR1 $ST; sleep 0.5; cp {report} {tmp_path}/snap.json

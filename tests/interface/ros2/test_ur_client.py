@@ -31,7 +31,7 @@ def _with_station(station: str, solve: str, tmp: Path, name: str) -> list[str]:
     """Lines: start ``station`` in the background, wait for its ready line, run ``solve`` (its exit code into
     ``<name>.code``), stop the station with SIGINT."""
     return [f"{station} > {tmp}/{name}.st.out 2> {tmp}/{name}.st.err &", "ST=$!",
-            f"wait_ready {tmp}/{name}.st.out || exit 90",
+            f"wait_ready {tmp}/{name}.st.err || exit 90",
             f"{solve} > {tmp}/{name}.out 2> {tmp}/{name}.err; echo $? > {tmp}/{name}.code",
             "kill -INT $ST; wait $ST; echo \"station exit $?\" >&2"]
 

@@ -37,7 +37,7 @@ def _script(env: PeerEnv, tmp_path: Path, station_args: str, *peers: str, backgr
     ``peer<i>.json``), stop the background process and the station with SIGINT; exit with the first failing peer's
     code."""
     lines = [f"{env.station_prefix()} $UR3HANOI ros2-station --driver ur {station_args} --report {tmp_path}/report.json"
-             f" > {tmp_path}/st.out 2> {tmp_path}/st.err &", "ST=$!", f"wait_ready {tmp_path}/st.out || exit 90",
+             f" > {tmp_path}/st.out 2> {tmp_path}/st.err &", "ST=$!", f"wait_ready {tmp_path}/st.err || exit 90",
              "CODE=0"]
     if background:
         lines += [f"{background} > {tmp_path}/bg.out 2> {tmp_path}/bg.err &", "BG=$!"]

@@ -85,7 +85,8 @@ class Ros2DriverStation(DriverStation):
                                            "remove": "ur3hanoi/remove_block", "hold": "ur3hanoi/hold_arm"}
 
     def __init__(self, options: Ros2DriverOptions, out: Callable[[str], None] | None = None,
-                 log: Callable[[str], None] | None = None) -> None:
+                 log: Callable[[str], None] | None = None,
+                 report_out: Callable[[str], None] | None = None) -> None:
         from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 
         if options.distro not in ROS_DISTROS:
@@ -98,9 +99,11 @@ class Ros2DriverStation(DriverStation):
             from dataclasses import replace
 
             options = replace(options, profile=profile_for(options.distro))
-        printed = out if out is not None else (lambda s: print(s, flush=True))
+        # stdout carries the JSON report alone (``station > report.json``); the ready line goes with the logs
+        said = out if out is not None else (lambda s: print(s, file=sys.stderr, flush=True))
         self._log_line = log if log is not None else (lambda s: print(s, file=sys.stderr, flush=True))
-        super().__init__(options, printed, printed)
+        report = report_out if report_out is not None else out if out is not None else (lambda s: print(s, flush=True))
+        super().__init__(options, said, report)
         self.names = names_for(options.distro)
         self._goals: dict[Hashable, _Goal] = {}
         self._lock = threading.Lock()

@@ -37,6 +37,7 @@
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
@@ -102,6 +103,7 @@ class _Solve:
         self.goals = 0
         self.n_goals = 0
         self.active: GoalHandle | None = None
+        self.last: dict[int, bool | None] = {}  # each output's last state set_io confirmed (None: asked, unanswered)
 
     # ------------------------------------------------------------------------------------------ reading
     def held(self) -> bool:
@@ -184,7 +186,10 @@ class _Solve:
 
     def output(self, pin: int, on: bool, key: str) -> None:
         """``set_io`` digital output ``pin`` (the calibration's ``io.<key>``) on or off."""
-        if not self.tr.set_io(FUN_SET_DIGITAL_OUT, pin, 1.0 if on else 0.0):
+        self.last[pin] = None
+        if self.tr.set_io(FUN_SET_DIGITAL_OUT, pin, 1.0 if on else 0.0):
+            self.last[pin] = on
+        else:
             raise DriverError(f"set_io(fun={FUN_SET_DIGITAL_OUT}, pin={pin}, state={1 if on else 0}) answered "
                               f"success = false on {self.tr.where}: is the pin right (calibration io.{key}) and the "
                               "robot program running?")
@@ -201,13 +206,13 @@ class _Solve:
 
     def all_off(self, failing: bool) -> None:
         """The way out: cancel a running goal (and let the arm stop), then every suction output off, the cup's
-        first. While ``failing`` (an exception, an interrupt, on its way out) nothing here may replace it: a step
+        first (all but those this solve has already seen switched off). While ``failing`` (an exception, an interrupt, on its way out) nothing here may replace it: a step
         that fails, even by a second Ctrl-C, is said and the next one still runs; otherwise a failure raises."""
         failed: list[str] = []
         steps: list[tuple[str, Callable[[], None]]] = [("cancel", self._stop_active)]
         for pin, key in ((self.wiring.output, "suction_output"), (self.wiring.generator, GENERATOR_KEY)):
-            if pin is not None:
-                steps.append((output_name(pin), lambda pin=pin, key=key: self.output(pin, False, key)))
+            if pin is not None and self.last.get(pin) is not False:
+                steps.append((output_name(pin), functools.partial(self.output, pin, False, key)))
         for what, step in steps:
             try:
                 step()
