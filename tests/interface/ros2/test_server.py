@@ -61,14 +61,15 @@ def test_default_dds_configuration_is_loopback_only() -> None:
 @pytest.mark.dds
 @requires_netns
 def test_ros2_solve_solves_on_the_ur3e_station_over_dds(tmp_path: Path) -> None:
-    report = tmp_path / "report.json"
+    """Without --report the station's stdout is its JSON report alone, written when SIGTERM stops it."""
+    report = tmp_path / "st.out"
     script = f"""
-$UR3HANOI ros2-station --timing honest --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
+$UR3HANOI ros2-station --timing honest > {report} 2> {tmp_path}/st.err &
 ST=$!
 wait_ready {tmp_path}/st.err || exit 90
 $UR3HANOI ros2-solve --start 1 --end 3 --v 4 --a 4 --json
 CODE=$?
-kill -INT $ST; wait $ST; echo "station exit $?" >&2
+kill -TERM $ST; wait $ST; echo "station exit $?" >&2
 exit $CODE
 """
     result = in_netns(script, 240.0, REPO)
@@ -81,7 +82,7 @@ exit $CODE
     assert r["final"]["at_home"] and not r["final"]["suction_on"]
     assert r["commands"]["rejected"] == 0 and r["transport"]["network"] == "loopback"
     assert r["suction"]["profile"] == "real"
-    assert "ready on ROS_DOMAIN_ID 0 (loopback): ur3e_sim" in (tmp_path / "st.out").read_text()
+    assert "ready on ROS_DOMAIN_ID 0 (loopback): ur3e_sim" in (tmp_path / "st.err").read_text()
 
 
 @pytest.mark.dds
