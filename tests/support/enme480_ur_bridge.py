@@ -60,6 +60,10 @@ class Bridge(Node):
         others = ReentrantCallbackGroup()
         self.action = ActionClient(self, FollowJointTrajectory, action_name, callback_group=others)
         self.set_io = self.create_client(SetIO, "/io_and_status_controller/set_io", callback_group=others)
+        # As the bridge's constructor: the generator on before the course's topics exist (a student's program waits
+        # for ur3e/position)
+        self.set_io.wait_for_service(timeout_sec=30.0)
+        io_start_stop(self, True)  # "Turning ON the vacuum generator"
         self.pub_position = self.create_publisher(PositionUR3e, "ur3e/position", 10)
         self.pub_gripper = self.create_publisher(GripperInput, "ur3e/gripper_input", 10)
         self.pub_grasping = self.create_publisher(Bool, "gripper/grasping", 10)
@@ -123,8 +127,6 @@ def io_start_stop(bridge, on):
 def main():
     rclpy.init()
     bridge = Bridge(sys.argv[1])
-    bridge.set_io.wait_for_service(timeout_sec=30.0)
-    io_start_stop(bridge, True)  # "Turning ON the vacuum generator"
     executor = MultiThreadedExecutor(num_threads=4)
     executor.add_node(bridge)
     try:

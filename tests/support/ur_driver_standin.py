@@ -92,7 +92,7 @@ def main():
     executor.add_node(node)
     thread = threading.Thread(target=executor.spin, daemon=True)
     thread.start()
-    print("ur3hanoi ros2-station: ready (stand-in)", file=sys.stderr, flush=True)  # as the station: stdout is its report
+    print("ur3hanoi ros2-station: ready (stand-in)", file=sys.stderr, flush=True)  # as the station: stdout = report
     try:
         while True:
             time.sleep(0.1)

@@ -206,8 +206,9 @@ class _Solve:
 
     def all_off(self, failing: bool) -> None:
         """The way out: cancel a running goal (and let the arm stop), then every suction output off, the cup's
-        first (all but those this solve has already seen switched off). While ``failing`` (an exception, an interrupt, on its way out) nothing here may replace it: a step
-        that fails, even by a second Ctrl-C, is said and the next one still runs; otherwise a failure raises."""
+        first (all but those this solve has already seen switched off). While ``failing`` (an exception, an
+        interrupt, on its way out) nothing here may replace it: a step that fails, even by a second Ctrl-C, is said
+        and the next one still runs; otherwise a failure raises."""
         failed: list[str] = []
         steps: list[tuple[str, Callable[[], None]]] = [("cancel", self._stop_active)]
         for pin, key in ((self.wiring.output, "suction_output"), (self.wiring.generator, GENERATOR_KEY)):
