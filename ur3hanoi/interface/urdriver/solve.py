@@ -112,15 +112,6 @@ class _Solve:
         io = self.tr.latest().io
         return io is not None and io.digital_in[self.wiring.switch_input]
 
-    def feedback_text(self, outputs: bool = False) -> str:
-        """``DI0=0, AI0=1.05 V`` (with ``outputs``: and the suction's outputs as ``io_states`` reads them)."""
-        io, w = self.tr.latest().io, self.wiring
-        if io is None:
-            return "no io_states"
-        text = f"DI{w.switch_input}={int(io.digital_in[w.switch_input])}, AI{w.sensor_input}=" \
-               f"{io.analog_in[w.sensor_input][1]:.2f} V"
-        return text + "".join(f", DO{pin}={int(io.digital_out[pin])}" for pin in w.outputs) if outputs else text
-
     def q(self) -> FloatArray:
         st = self.tr.latest()
         if st.q is None:
@@ -283,7 +274,7 @@ class _Solve:
         """Suction off, the arm at rest, then home; the error to raise."""
         if kind == "missing" and _no_vacuum(self.tr.latest().io, self.wiring, self.plan.station.suction):
             kind = "vacuum"
-        feedback = self.feedback_text(outputs=kind == "vacuum")
+        feedback = _feedback_text(self.tr.latest().io, self.wiring, outputs=kind == "vacuum")
         self.suction(False)
         self.at_rest()
         self.move_to(self.plan.station.q_home_array, self.cfg.home_speed, "home after the halt")
@@ -298,6 +289,15 @@ class _Solve:
         return SuctionFaultError(f"suction fault in move {move + 1}/{len(moves)}: {what} ({feedback}); halted, "
                                  f"suction off, arm returned home{hint}")
 
+
+
+def _feedback_text(io: IoStates | None, w: SuctionWiring, outputs: bool = False) -> str:
+    """``DI0=0, AI0=1.05 V`` (with ``outputs``: and the suction's outputs as ``io_states`` reads them)."""
+    if io is None:
+        return "no io_states"
+    text = f"DI{w.switch_input}={int(io.digital_in[w.switch_input])}, AI{w.sensor_input}=" \
+           f"{io.analog_in[w.sensor_input][1]:.2f} V"
+    return text + "".join(f", DO{pin}={int(io.digital_out[pin])}" for pin in w.outputs) if outputs else text
 
 
 def _no_vacuum(io: IoStates | None, w: SuctionWiring, profile: SuctionProfile) -> bool:
