@@ -66,7 +66,8 @@ def test_a_three_block_solve_runs_the_plan_in_its_own_time(tmp_path):
     # solve prints them.
     assert lines == ["vacuum generator on: configurable output 4 (set_io pin 12) (calibration "
                      "io.vacuum_generator_output)"] + [f"move {i + 1}/7: {describe_move(mv)}"
-                                                       for i, mv in enumerate(p.moves)]
+                                                       for i, mv in enumerate(p.moves)] + \
+        ["vacuum generator off: configurable output 4 (set_io pin 12)"]
     # ... and every output off at the end, the cup's first, as the bridge leaves the cell (the station logs the
     # last calls in its next cycle)
     st.cycle()
@@ -266,8 +267,13 @@ def test_every_way_out_mid_carry_stops_the_arm_and_switches_every_output_off(tmp
     st = station(n_blocks=1, calibration=wired(tmp_path))
     tr = StopMidCarry(st, stop)
     tr.connect()
+    lines: list[str] = []
     with pytest.raises(raised):
-        run_driver_solve(tr, plan(1), st.station.wiring)
+        run_driver_solve(tr, plan(1), st.station.wiring, log=lines.append)
+    # what the way out did, said (an aborted goal has ended and the error path has switched the cup off already)
+    assert lines[-1] == "stopping: " + ("configurable output 4 (set_io pin 12) off" if raised is DriverGoalError else
+                                        "the running goal canceled, digital output 0 off, configurable output 4 "
+                                        "(set_io pin 12) off")
     st.cycle()
     report = st.report()
     assert tr.held_cycles == 25 and io_calls(st)[0] == (12, 1.0) and io_calls(st)[-2:] == [(0, 0.0), (12, 0.0)]

@@ -189,32 +189,14 @@ class _Solve:
             self.output(pin, True, GENERATOR_KEY)
             self.say(f"vacuum generator on: {output_name(pin)} (calibration io.{GENERATOR_KEY})")
 
-    def all_off(self, failing: bool) -> None:
-        """The way out: cancel a running goal (and let the arm stop), then every suction output off, the cup's
-        first (all but those this solve has already seen switched off). While ``failing`` (an exception, an
-        interrupt, on its way out) nothing here may replace it: a step that fails, even by a second Ctrl-C, is said
-        and the next one still runs; otherwise a failure raises."""
-        failed: list[str] = []
-        steps: list[tuple[str, Callable[[], None]]] = [("cancel", self._stop_active)]
-        for pin, key in ((self.wiring.output, "suction_output"), (self.wiring.generator, GENERATOR_KEY)):
-            if pin is not None and self.last.get(pin) is not False:
-                steps.append((output_name(pin), functools.partial(self.output, pin, False, key)))
-        for what, step in steps:
-            try:
-                step()
-            except (Exception, KeyboardInterrupt) as exc:
-                if not failing:
-                    raise
-                failed.append(f"{what} ({type(exc).__name__}: {exc})" if str(exc) else what)
-        if failed:
-            self.say(f"on the way out, could not switch off or stop: {'; '.join(failed)}: switch the outputs "
-                     "off on the pendant (I/O tab)")
-
-    def _stop_active(self) -> None:
+    def stop_active(self) -> bool:
+        """Cancel the running goal and wait for the arm to stop; False: none was running."""
         handle, self.active = self.active, None
-        if handle is not None and not handle.done():
-            self._cancel(handle)
-            self.at_rest()
+        if handle is None or handle.done():
+            return False
+        self._cancel(handle)
+        self.at_rest()
+        return True
 
     def move_to(self, q1: FloatArray, speed: float, what: str) -> float:
         """A slow goal from where the arm is to ``q1``; returns its duration [s]."""
@@ -290,6 +272,35 @@ class _Solve:
                                  f"suction off, arm returned home{hint}")
 
 
+def _all_off(run: _Solve, failing: bool) -> None:
+    """The way out: cancel a running goal (and let the arm stop), then every suction output off, the cup's
+    first (all but those this solve has already seen switched off). While ``failing`` (an exception, an
+    interrupt, on its way out) nothing here may replace it: a step that fails, even by a second Ctrl-C, is said
+    and the next one still runs; otherwise a failure raises."""
+    failed: list[str] = []
+    done: list[str] = []
+    steps: list[tuple[str, str, Callable[[], object]]] = [
+        ("the running goal canceled", "the running goal", run.stop_active)]
+    for pin, key in ((run.wiring.output, "suction_output"), (run.wiring.generator, GENERATOR_KEY)):
+        if pin is not None and run.last.get(pin) is not False:
+            steps.append((f"{output_name(pin)} off", output_name(pin),
+                          functools.partial(run.output, pin, False, key)))
+    for said, what, step in steps:
+        try:
+            if step() is not False:
+                done.append(said)
+        except (Exception, KeyboardInterrupt) as exc:
+            if not failing:
+                raise
+            failed.append(f"{what} ({type(exc).__name__}{': ' if str(exc) else ''}{exc})")
+    if failing and done:
+        run.say(f"stopping: {', '.join(done)}")
+    elif not failing and run.wiring.generator is not None:
+        run.say(f"vacuum generator off: {output_name(run.wiring.generator)}")
+    if failed:
+        run.say(f"on the way out, could not switch off or stop: {'; '.join(failed)}: switch the outputs "
+                "off on the pendant (I/O tab)")
+
 
 def _feedback_text(io: IoStates | None, w: SuctionWiring, outputs: bool = False) -> str:
     """``DI0=0, AI0=1.05 V`` (with ``outputs``: and the suction's outputs as ``io_states`` reads them)."""
@@ -338,9 +349,9 @@ def run_driver_solve(transport: DriverTransport, plan: Plan, wiring: SuctionWiri
     try:
         result = _execute(run)
     except BaseException:
-        run.all_off(failing=True)
+        _all_off(run, failing=True)
         raise
-    run.all_off(failing=False)
+    _all_off(run, failing=False)
     return result
 
 
