@@ -18,6 +18,8 @@ def test_defaults_are_the_courses_wiring_per_arm():
     assert load_station("lab_sim").wiring == SuctionWiring(output=0, switch_input=0, sensor_input=0, generator=None)
     assert load_station("ur3e_sim").wiring == SuctionWiring(output=1, switch_input=0, sensor_input=0, generator=12)
     assert load_station("ur3e_sim").wiring.outputs == (12, 1)
+    assert load_station("ur3e_sim").wiring.describe() == "suction on DO 1, vacuum generator on DO 12"
+    assert load_station("lab_sim").wiring.describe() == "suction on DO 0"
     assert output_name(12) == "configurable output 4 (set_io pin 12)"
     assert output_name(1) == "digital output 1"
     assert output_name(17) == "tool output 1 (set_io pin 17)"

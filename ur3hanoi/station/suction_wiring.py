@@ -63,6 +63,11 @@ class SuctionWiring:
         off at the end."""
         return (self.output,) if self.generator is None else (self.generator, self.output)
 
+    def describe(self) -> str:
+        """``suction on DO 1, vacuum generator on DO 12`` (``set_io`` pins), for a station's ready line."""
+        return f"suction on DO {self.output}" + ("" if self.generator is None else
+                                                 f", vacuum generator on DO {self.generator}")
+
     def as_dict(self) -> dict[str, int | None]:
         """The ``io:`` section of a calibration file."""
         return {"suction_output": self.output, GENERATOR_KEY: self.generator,

@@ -234,5 +234,5 @@ class Ros2DriverStation(DriverStation):
         return (f"{READY_LINE} on ROS_DOMAIN_ID {self.domain_id} ({opts.network}): the UR driver's interface "
                 f"({opts.distro}: {self.names.follow_joint_trajectory}), {st.name} ({st.robot.title}), {w.n_blocks} "
                 f"blocks on tower {opts.start + 1}, {1.0 / w.config.period_s:g} Hz, speed scaling "
-                f"{opts.speed_scaling:g}, suction on DO {st.wiring.output} (pid {os.getpid()})")
+                f"{opts.speed_scaling:g}, {st.wiring.describe()} (pid {os.getpid()})")
 
