@@ -114,7 +114,8 @@ def test_no_driver_rejected_and_aborted_goals_end_with_one_line(tmp_path: Path) 
         assert code == 2 and len(errors) == 1 and expected in errors[0], err
         standin = json.loads((tmp_path / f"{mode}.st.out").read_text().strip().splitlines()[-1])
         assert standin["goals"] == 1
-        assert not standin["io_calls"] or standin["io_calls"][-1] == [1, 1, 0.0]  # suction off at the end
+        # ur3e_sim's wiring: the generator (pin 12) on first; at the end the cup off, then the generator
+        assert standin["io_calls"] == [[1, 12, 1.0], [1, 1, 0.0], [1, 12, 0.0]], standin["io_calls"]
 
 
 if __name__ == "__main__":
