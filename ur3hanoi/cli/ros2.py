@@ -94,6 +94,7 @@ def _distro(args: argparse.Namespace) -> str:
 
 
 def _run_station(args: argparse.Namespace) -> int:
+    driver.program_times(args)  # a contradiction in the program options: one line before any work
     report_file = remote.check_station_outputs(args, DEFAULT_ROS2_CALIBRATION)  # before any work
     fields = remote.station_options(args, DEFAULT_ROS2_CALIBRATION, report_file)
     if args.driver == "ur":
@@ -102,10 +103,12 @@ def _run_station(args: argparse.Namespace) -> int:
 
         import_rclpy()  # say what is missing before loading the world
 
+        stop, resume = driver.program_times(args)
         with remote.ReportStdout() as report_out:
             report = Ros2DriverStation(Ros2DriverOptions(**fields, speed_scaling=args.speed_scaling,
                                                          distro=_distro(args), network=args.network,
-                                                         domain_id=args.domain_id), report_out=report_out).run()
+                                                         domain_id=args.domain_id, program_stop_at_s=stop,
+                                                         program_resume_at_s=resume), report_out=report_out).run()
     else:
         from ur3hanoi.interface.ros2.server import Ros2Server, Ros2ServerOptions
 
