@@ -55,11 +55,10 @@ from ur3hanoi.interface.common.moves import describe_move
 from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverTransport, GoalHandle, GoalResult
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, FUN_SET_DIGITAL_OUT, ErrorCode
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
-from ur3hanoi.interface.urdriver.io import IoStates
 from ur3hanoi.interface.urdriver.path_deviation import PathDeviation, path_deviation, stretch_windows
 from ur3hanoi.interface.urdriver.plan_goals import Stretch, move_goal, plan_stretches
+from ur3hanoi.interface.urdriver.vacuum import feedback_text, no_vacuum, vacuum_hint
 from ur3hanoi.plan import Plan
-from ur3hanoi.station.suction_profile import SuctionProfile
 from ur3hanoi.station.suction_wiring import GENERATOR_KEY, SuctionWiring, output_name
 
 
@@ -285,9 +284,9 @@ class _Solve:
 
     def halt(self, kind: str, move: int) -> SuctionFaultError:
         """Suction off, the arm at rest, then home; the error to raise."""
-        if kind == "missing" and _no_vacuum(self.tr.latest().io, self.wiring, self.plan.station.suction):
+        if kind == "missing" and no_vacuum(self.tr.latest().io, self.wiring, self.plan.station.suction):
             kind = "vacuum"
-        feedback = _feedback_text(self.tr.latest().io, self.wiring, outputs=kind == "vacuum")
+        feedback = feedback_text(self.tr.latest().io, self.wiring, outputs=kind == "vacuum")
         self.suction(False)
         self.at_rest()
         self.move_to(self.plan.station.q_home_array, self.cfg.home_speed, "home after the halt")
@@ -298,7 +297,7 @@ class _Solve:
         block = f"{block_colour(mv.block)} block {mv.block + 1}"
         what = {"missing": f"{block} is missing {where}", "dropped": f"{block} was dropped {where}",
                 "vacuum": f"no vacuum at the grasp of {block} {where}"}[kind]
-        hint = _vacuum_hint(self.wiring) if kind == "vacuum" else ""
+        hint = vacuum_hint(self.wiring) if kind == "vacuum" else ""
         return SuctionFaultError(f"suction fault in move {move + 1}/{len(moves)}: {what} ({feedback}); halted, "
                                  f"suction off, arm returned home{hint}")
 
@@ -331,35 +330,6 @@ def _all_off(run: _Solve, failing: bool) -> None:
     if failed:
         run.say(f"on the way out, could not switch off or stop: {'; '.join(failed)}: switch the outputs "
                 "off on the pendant (I/O tab)")
-
-
-def _feedback_text(io: IoStates | None, w: SuctionWiring, outputs: bool = False) -> str:
-    """``DI0=0, AI0=1.05 V`` (with ``outputs``: and the suction's outputs as ``io_states`` reads them)."""
-    if io is None:
-        return "no io_states"
-    text = f"DI{w.switch_input}={int(io.digital_in[w.switch_input])}, AI{w.sensor_input}=" \
-           f"{io.analog_in[w.sensor_input][1]:.2f} V"
-    return text + "".join(f", DO{pin}={int(io.digital_out[pin])}" for pin in w.outputs) if outputs else text
-
-
-def _no_vacuum(io: IoStates | None, w: SuctionWiring, profile: SuctionProfile) -> bool:
-    """The vacuum sensor reads the calibration's no-vacuum level though the cup's output is on."""
-    if io is None or not io.digital_out[w.output]:
-        return False
-    volts = io.analog_in[w.sensor_input][1]
-    return abs(volts - profile.ain0_off) < abs(volts - profile.ain0_free)
-
-
-def _vacuum_hint(w: SuctionWiring) -> str:
-    """What to check when the cup's output is on and the sensor reads no vacuum: the generator's pin."""
-    cup = f"The cup's {output_name(w.output)} (io.suction_output) is on but the vacuum sensor reads no vacuum"
-    if w.generator is None:
-        return (f". {cup}, and the calibration names no vacuum generator output (io.{GENERATOR_KEY}): if the "
-                "cell switches its generator from the robot (ENME480's UR3e: set_io pin 12, configurable "
-                f"output 4), write that pin into io.{GENERATOR_KEY}")
-    return (f". {cup}, with the vacuum generator's {output_name(w.generator)} (io.{GENERATOR_KEY}) on since the "
-            "start: is that the generator's pin (the pendant's I/O tab shows which output makes the vacuum), "
-            "and does the generator have air?")
 
 
 def run_driver_solve(transport: DriverTransport, plan: Plan, wiring: SuctionWiring,
