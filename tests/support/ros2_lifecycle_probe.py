@@ -63,7 +63,8 @@ def start_station(folder: Path, name: str, *args: str) -> subprocess.Popen[str]:
 def ready(proc: subprocess.Popen[str], folder: Path, name: str) -> subprocess.Popen[str]:
     """``proc`` once its ready line is out."""
     out = folder / f"{name}.out"
-    if wait_for(lambda: "ros2-station: ready" in out.read_text() or proc.poll() is not None, 90.0) is None \
+    err = folder / f"{name}.err"  # the ready line is on stderr: stdout carries the JSON report alone
+    if wait_for(lambda: "ros2-station: ready" in err.read_text() or proc.poll() is not None, 90.0) is None \
             or proc.poll() is not None:
         proc.kill()
         raise SystemExit(f"station {name} not ready: {out.read_text()} {(folder / f'{name}.err').read_text()}")

@@ -9,7 +9,6 @@ fault exits with 3. Heavy imports (MuJoCo, rospy) happen only when a command run
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -76,27 +75,20 @@ def _node(args: argparse.Namespace, report_file: Path | None) -> RosStation:
     if args.driver == "ur":
         from ur3hanoi.interface.ros1.ur_server import RosDriverOptions, RosDriverServer
 
+        stop, resume = driver.program_times(args)
         return RosDriverServer(RosDriverOptions(**fields, master_uri=args.master, host=args.host,
-                                                speed_scaling=args.speed_scaling))
+                                                speed_scaling=args.speed_scaling, program_stop_at_s=stop,
+                                                program_resume_at_s=resume))
     return RosServer(RosServerOptions(**fields, master_uri=args.master, host=args.host))
 
 
 def _run_station(args: argparse.Namespace) -> int:
+    driver.program_times(args)  # a contradiction in the program options: one line before any work
     report_file = remote.check_station_outputs(args, DEFAULT_CALIBRATION)  # before any work
     node = _node(args, report_file)
-    # Standard output carries only the JSON report: whatever else writes to file descriptor 1 (rospy's info
-    # handler, C libraries) goes to stderr while the node runs.
-    sys.stdout.flush()
-    report_fd = os.dup(1)
-    os.dup2(2, 1)
-    try:
-        with os.fdopen(os.dup(report_fd), "w") as report_out:
-            node.report_out = lambda text: print(text, file=report_out, flush=True)
-            report = node.run()
-    finally:
-        sys.stdout.flush()
-        os.dup2(report_fd, 1)
-        os.close(report_fd)
+    with remote.ReportStdout() as report_out:
+        node.report_out = report_out
+        report = node.run()
     if report_file is not None and args.driver == "ur":
         print(remote.stopped_line("ros-station", report, f"report {args.report}"), file=sys.stderr, flush=True)
     elif report_file is not None:
@@ -153,6 +145,10 @@ def _add_env(sub: argparse._SubParsersAction) -> None:
         "`python lab2_exec.py --simulator True` runs against ros-station without a catkin workspace.")
     p.add_argument("--dir", metavar="DIR", help="folder to write (default: $XDG_CACHE_HOME/ur3hanoi/ros)")
     p.add_argument("--master", metavar="URI", help=_master_help())
+    p.add_argument("--driver", choices=driver.DRIVERS, default="course",
+                   help="ur: also write the official UR driver's message packages (control_msgs, "
+                        "controller_manager_msgs, cartesian_control_msgs, std_srvs, ur_dashboard_msgs), so UR's own "
+                        "clients (ur_robot_driver's scripts/test_move) run against ros-station --driver ur")
     p.set_defaults(func=_run_env)
 
 
@@ -165,7 +161,13 @@ def _run_env(args: argparse.Namespace) -> int:
     uri = args.master or master_uri_from_env()
     MasterUri.parse(uri)
     files = write_client_env(folder)
-    print(f"# ur3hanoi ros-env: wrote {len(files)} files (ur3_driver messages) to {folder}", file=sys.stderr)
+    what = "ur3_driver messages"
+    if args.driver == "ur":
+        from ur3hanoi.interface.ros1.ur_packages import write_ur_packages
+
+        files += write_ur_packages(folder)
+        what += " and the UR driver's message packages"
+    print(f"# ur3hanoi ros-env: wrote {len(files)} files ({what}) to {folder}", file=sys.stderr)
     for line in env_lines(folder, uri):
         print(line)
     return 0

@@ -8,6 +8,7 @@ exit code 2; a suction fault exits with 3. Heavy imports (MuJoCo, Cyclone DDS) h
 from __future__ import annotations
 
 import argparse
+import sys
 
 from ur3hanoi.cli import driver, remote
 
@@ -93,6 +94,7 @@ def _distro(args: argparse.Namespace) -> str:
 
 
 def _run_station(args: argparse.Namespace) -> int:
+    driver.program_times(args)  # a contradiction in the program options: one line before any work
     report_file = remote.check_station_outputs(args, DEFAULT_ROS2_CALIBRATION)  # before any work
     fields = remote.station_options(args, DEFAULT_ROS2_CALIBRATION, report_file)
     if args.driver == "ur":
@@ -101,17 +103,21 @@ def _run_station(args: argparse.Namespace) -> int:
 
         import_rclpy()  # say what is missing before loading the world
 
-        report = Ros2DriverStation(Ros2DriverOptions(**fields, speed_scaling=args.speed_scaling,
-                                                     distro=_distro(args), network=args.network,
-                                                     domain_id=args.domain_id)).run()
+        stop, resume = driver.program_times(args)
+        with remote.ReportStdout() as report_out:
+            report = Ros2DriverStation(Ros2DriverOptions(**fields, speed_scaling=args.speed_scaling,
+                                                         distro=_distro(args), network=args.network,
+                                                         domain_id=args.domain_id, program_stop_at_s=stop,
+                                                         program_resume_at_s=resume), report_out=report_out).run()
     else:
         from ur3hanoi.interface.ros2.server import Ros2Server, Ros2ServerOptions
 
         options = Ros2ServerOptions(**fields, timing=args.timing, convention=args.convention, network=args.network,
                                     domain_id=args.domain_id)
-        report = Ros2Server(options).run()
+        with remote.ReportStdout() as report_out:
+            report = Ros2Server(options, report_out=report_out).run()
     if report_file is not None:
-        print(remote.stopped_line("ros2-station", report, f"report {args.report}"), flush=True)
+        print(remote.stopped_line("ros2-station", report, f"report {args.report}"), file=sys.stderr, flush=True)
     return 0
 
 

@@ -18,7 +18,14 @@ and order are the driver's (:data:`ur3hanoi.interface.urdriver.facts.ROS1`):
 - ``/ur_hardware_interface/robot_program_running`` (``std_msgs/Bool``, latched);
 - fault injection: ``/ur3hanoi/hold_arm`` (``std_msgs/Float64``: seconds the arm is held where it is) and
   ``/ur3hanoi/program_running`` (``std_msgs/Bool``: false stops the robot program, as on the pendant: the running
-  goal is preempted, new goals get INVALID_GOAL until it runs again).
+  goal is preempted (``JointTrajectoryController::stopping``), new goals are rejected with INVALID_GOAL and no
+  ``error_string`` (``goalCB``, ros_controllers noetic-devel ``joint_trajectory_controller_impl.h``) until it runs
+  again); the same at the times of ``--program-stop-at`` / ``--program-resume-at``;
+- ``/controller_manager/list_controllers``, ``load_controller`` and ``switch_controller``
+  (``controller_manager_msgs``, :class:`~ur3hanoi.interface.urdriver.controllers.Ros1ControllerManager`) and the
+  dashboard's ``/ur_hardware_interface/dashboard/play``, ``stop`` (``std_srvs/Trigger``) and ``program_running``
+  (``ur_dashboard_msgs/IsProgramRunning``), tied to the program state: UR's ``scripts/test_move`` runs against it
+  unmodified (with :func:`~ur3hanoi.interface.ros1.ur_packages.write_ur_packages`' packages on its path).
 """
 
 from __future__ import annotations
@@ -35,13 +42,17 @@ from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1, ROS1_JOIN
 from ur3hanoi.interface.urdriver.follower import Feedback, Outcome
 from ur3hanoi.interface.urdriver.goal import JointTolerance, Rejection, TrajectoryGoal, TrajectoryPoint
 from ur3hanoi.interface.urdriver.io import IoStatesMessage
+from ur3hanoi.interface.urdriver.services import ServiceCall
 from ur3hanoi.interface.urdriver.station import DriverStation, DriverStationOptions
 
 HOLD_TOPIC = "/ur3hanoi/hold_arm"
 """Fault injection: ``std_msgs/Float64`` seconds the arm is held (a person or an obstacle in the way)."""
 PROGRAM_TOPIC = "/ur3hanoi/program_running"
 """Fault injection: ``std_msgs/Bool`` false = the robot program stopped on the pendant (the controller stops)."""
-PROGRAM_RUNNING = "/ur_hardware_interface/robot_program_running"
+DASHBOARD = "/ur_hardware_interface/dashboard"
+"""The ROS 1 driver's dashboard services (``ur_robot_driver``'s ``dashboard_client``, in the hardware interface's
+namespace)."""
+PROGRAM_RUNNING = ROS1.program_running
 """The driver's latched ``std_msgs/Bool``: whether the robot program runs."""
 
 
@@ -118,7 +129,7 @@ class RosDriverServer(RosStation, DriverStation):
     def _ready_detail(self) -> str:
         opts = self.options
         return (f"the UR driver's interface ({opts.profile.name}) at {1.0 / self.world.config.period_s:g} Hz, speed "
-                f"slider {100 * opts.speed_scaling:g} %, suction on DO{self.station.wiring.output}")
+                f"slider {100 * opts.speed_scaling:g} %, {self.station.wiring.describe()}")
 
     def _open(self, rospy: Any) -> Callable[[], None]:
         import importlib
@@ -139,9 +150,10 @@ class RosDriverServer(RosStation, DriverStation):
         rospy.Service(ROS1.set_io, set_io, self._on_set_io)
         rospy.Subscriber(HOLD_TOPIC, std_msgs.Float64, lambda msg: self.on_hold(msg.data), queue_size=10)
         rospy.Subscriber(PROGRAM_TOPIC, std_msgs.Bool, lambda msg: self.on_program(msg.data), queue_size=10)
+        self._services(rospy)
         program = rospy.Publisher(PROGRAM_RUNNING, std_msgs.Bool, queue_size=1, latch=True)
-        running = [True]
-        program.publish(std_msgs.Bool(True))
+        running = [self.output.program_running]
+        program.publish(std_msgs.Bool(running[0]))
         order = np.array([CONTROLLER_JOINTS.index(n) for n in ROS1_JOINT_STATE_ORDER])
         unit = self.options.profile.speed_scaling_unit
         io_msg = IoStatesMessage(m)
@@ -154,12 +166,59 @@ class RosDriverServer(RosStation, DriverStation):
             pubs[0].publish(js)
             pubs[1].publish(io_msg.update(out.io))
             pubs[2].publish(std_msgs.Float64(out.speed_scaling * unit))
-            if self.follower.running != running[0]:
-                running[0] = self.follower.running
+            if out.program_running != running[0]:
+                running[0] = out.program_running
                 program.publish(std_msgs.Bool(running[0]))
             self._goal_events(m, out.decisions, out.feedback, out.results, rospy.Time.now())
 
         return publish
+
+    def _services(self, rospy: Any) -> None:
+        """``controller_manager``'s list, load and switch, the dashboard's play, stop and program_running
+        (:mod:`~ur3hanoi.interface.urdriver.services`), with classes generated from the official texts."""
+        from ur3hanoi.interface.ros1.ur_packages import service_classes
+
+        c = service_classes()
+        cm = "controller_manager_msgs/"
+
+        def answer(call: ServiceCall) -> Any:
+            self.on_service(call)
+            return call.wait()
+
+        def listing(_req: Any) -> Any:
+            rows = answer(ServiceCall("list")) or []
+            res = c[f"{cm}HardwareInterfaceResources"]
+            states = [c[f"{cm}ControllerState"](name=n, state=s, type=t, claimed_resources=[] if not joints else [
+                res(hardware_interface=f"hardware_interface::{t.split('_')[0].capitalize()}JointInterface",
+                    resources=list(joints))]) for n, s, t, joints in rows]
+            return c[f"{cm}ListControllers"]._response_class(controller=states)
+
+        def switch(req: Any) -> Any:
+            ok = answer(ServiceCall("switch", req.start_controllers, req.stop_controllers, req.strictness))
+            return c[f"{cm}SwitchController"]._response_class(ok=bool(ok and ok[0]))
+
+        def load(req: Any) -> Any:
+            return c[f"{cm}LoadController"]._response_class(ok=bool(answer(ServiceCall("load", [req.name]))))
+
+        def trigger(kind: str) -> Any:
+            def call(_req: Any) -> Any:
+                result = answer(ServiceCall(kind)) or (False, "the station stopped")
+                return c["std_srvs/Trigger"]._response_class(success=result[0], message=result[1])
+            return call
+
+        def running(_req: Any) -> Any:
+            ok, text, value = answer(ServiceCall("running")) or (False, "the station stopped", False)
+            return c["ur_dashboard_msgs/IsProgramRunning"]._response_class(answer=text, program_running=value,
+                                                                            success=ok)
+
+        for name, srv, callback in (("list_controllers", "ListControllers", listing),
+                                    ("switch_controller", "SwitchController", switch),
+                                    ("load_controller", "LoadController", load)):
+            rospy.Service(f"/controller_manager/{name}", c[cm + srv], callback)
+        for kind, srv, callback in (("play", "std_srvs/Trigger", trigger("play")),
+                                    ("stop", "std_srvs/Trigger", trigger("stop")),
+                                    ("program_running", "ur_dashboard_msgs/IsProgramRunning", running)):
+            rospy.Service(f"{DASHBOARD}/{kind}", c[srv], callback)
 
     def _goal_events(self, m: DriverMessages, decisions: tuple[tuple[Any, Rejection | None], ...],
                      feedback: tuple[Any, Feedback] | None, results: tuple[tuple[Any, Outcome], ...],

@@ -6,8 +6,10 @@ log, report, rendering) whose arm is the simulated UR robot under the driver's s
 - the robot: :class:`ur3hanoi.sim.servo_world.ServoWorld` (joint limits, its own speed scaling times the slider
   ``speed_scaling``, the servo, suction, blocks);
 - the controller: :class:`~ur3hanoi.interface.urdriver.follower.TrajectoryFollower` with the options' profile;
-- the IO: :class:`~ur3hanoi.interface.urdriver.io.IoBoard`: the suction follows the digital output the calibration's
-  wiring names (:class:`ur3hanoi.station.suction_wiring.SuctionWiring`), and its feedback (today's suction model:
+- the IO: :class:`~ur3hanoi.interface.urdriver.io.IoBoard`: the cup pulls while the digital output the calibration's
+  wiring names is on and, on a cell with one, the vacuum generator's output too
+  (:class:`ur3hanoi.station.suction_wiring.SuctionWiring`; without the generator the cup is open to the air: no
+  vacuum, nothing picked, the sensor at its no-vacuum level), and its feedback (today's suction model:
   vacuum switch = ``DIGIN`` bit 0, vacuum sensor = ``AIN0``) reads on the wiring's digital and analog inputs.
 
 A binding calls, from any thread, :meth:`~DriverStation.on_goal`, :meth:`~DriverStation.on_cancel`,
@@ -22,10 +24,11 @@ from __future__ import annotations
 import time
 from collections.abc import Hashable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.interface.common.station import ServerCore, ServerOptions
+from ur3hanoi.interface.urdriver.controllers import ControllerManager, Ros1ControllerManager
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS
 from ur3hanoi.interface.urdriver.follower import Feedback, Outcome, TrajectoryFollower
 from ur3hanoi.interface.urdriver.goal import Rejection, TrajectoryGoal
@@ -45,11 +48,19 @@ class DriverStationOptions(ServerOptions):
     Attributes:
         speed_scaling: the pendant's speed slider, in (0, 1].
         profile: the controller's defaults and rules (ROS 1 or ROS 2).
+        program_stop_at_s, program_resume_at_s: fault injection: the External Control program stops (as when the
+            pendant's stop button is pressed) and starts again at these world times [s] (None: never).
+        initial_controller: ROS 2: the controller manager's initial motion controller
+            (:class:`~ur3hanoi.interface.urdriver.controllers.ControllerManager`); None: ROS 1's controller manager
+            (:class:`~ur3hanoi.interface.urdriver.controllers.Ros1ControllerManager`).
     """
 
     rate_hz: float | None = None
     speed_scaling: float = 1.0
     profile: ControllerProfile = ROS1_SCALED
+    program_stop_at_s: float | None = None
+    program_resume_at_s: float | None = None
+    initial_controller: str | None = None
 
 
 @dataclass(frozen=True)
@@ -64,6 +75,7 @@ class CycleOutput:
         decisions: goals decided this cycle: (key, None = accepted, or the rejection).
         feedback: the active goal's (key, feedback), or None.
         results: goals that ended this cycle: (key, outcome).
+        program_running: whether the External Control program runs (the driver's ``robot_program_running``).
     """
 
     t_s: float
@@ -76,6 +88,13 @@ class CycleOutput:
     decisions: tuple[tuple[Hashable, Rejection | None], ...] = ()
     feedback: tuple[Hashable, Feedback] | None = None
     results: tuple[tuple[Hashable, Outcome], ...] = ()
+    program_running: bool = True
+
+
+class StationCall(Protocol):
+    """A call answered in the control thread (:class:`ur3hanoi.interface.urdriver.services.ServiceCall`)."""
+
+    def answer(self, station: DriverStation) -> None: ...
 
 
 class DriverStation(ServerCore["ServoWorld"]):
@@ -96,6 +115,14 @@ class DriverStation(ServerCore["ServoWorld"]):
         self._decisions: list[tuple[Hashable, Rejection | None]] = []
         self._switch = False
         self._effort_ids = w.servo.act_ids
+        self._program_done: set[float] = set()
+        self.program_running = True
+        self.controllers: ControllerManager | Ros1ControllerManager = \
+            Ros1ControllerManager() if options.initial_controller is None else \
+            ControllerManager(options.initial_controller)
+        self._owner = self.controllers.trajectory_controller()
+        if options.program_stop_at_s is not None and options.program_stop_at_s <= 0.0:
+            self._scheduled_program()  # stopped from the start: the first output says so
         self.output = self._output((), None, ())
 
     def _build_world(self, config: SimConfig, n_blocks: int) -> ServoWorld:
@@ -151,18 +178,55 @@ class DriverStation(ServerCore["ServoWorld"]):
         elif kind == "io":
             self.records.io_call(t, *payload)
         elif kind == "program":
-            self.follower.set_running(payload)
-            self.log.log(self.TOPIC_LOG[kind], "warn", f"the robot program {'runs' if payload else 'stopped'}")
+            self.set_program(bool(payload))
+        elif kind == "service":
+            payload.answer(self)
         else:
             super()._handle(kind, payload)
+
+    def on_service(self, request: StationCall) -> None:
+        """A ``controller_manager`` or dashboard call (any thread): answered in the next control cycle."""
+        self.inbox.offer("service", request)
+
+    def sync_controllers(self) -> None:
+        """The follower runs while the program does and (ROS 2) a trajectory controller is active; a switch to
+        another one ends the running goal as a deactivation does."""
+        owner = self.controllers.trajectory_controller()
+        running = self.program_running and owner is not None
+        if owner != self._owner and self.follower.running:
+            self.follower.set_running(False)
+        self._owner = owner
+        self.follower.set_running(running)
+
+    def set_program(self, running: bool) -> None:
+        """The External Control program stops or starts (control thread): the controllers with it (the driver's
+        ``controller_stopper``); ``io_states`` and the joint states go on."""
+        if running == self.program_running:
+            return
+        self.program_running = running
+        self.controllers.program(running)
+        self.sync_controllers()
+        self.records.program_changed(self.world.time, running)
+        self.log.log(self.TOPIC_LOG["program"], "warn", "the External Control program runs again" if running else
+                     "the External Control program stopped: the trajectory controller is stopped, goals are refused")
+
+    def _scheduled_program(self) -> None:
+        """``--program-stop-at`` / ``--program-resume-at``: each once, when the world time reaches it."""
+        opts, t = self.options, self.world.time
+        for at, running in ((opts.program_stop_at_s, False), (opts.program_resume_at_s, True)):
+            if at is not None and at not in self._program_done and t >= at - 1e-9:
+                self._program_done.add(at)
+                self.set_program(running)
 
     # ------------------------------------------------------------------------------------------------ cycle
     def _step(self) -> None:
         """One control cycle: the IO writes, the controller, the robot, the feedback on the inputs."""
+        self._scheduled_program()
         w, period = self.world, self.world.config.period_s
         self.io.cycle()
         wiring = self.station.wiring
-        w.set_suction(self.io.digital_out(wiring.output))
+        vacuum = wiring.generator is None or self.io.digital_out(wiring.generator)  # the cell's generator, if any
+        w.set_suction(self.io.digital_out(wiring.output) and vacuum)
         s = w.speed_scaling
         d = self.follower.update(w.q, w.qd, period, s)
         assert d.qd is not None and d.qdd is not None
@@ -191,7 +255,7 @@ class DriverStation(ServerCore["ServoWorld"]):
         w = self.world
         effort = w.scene.data.actuator_force[self._effort_ids]  # a copy (fancy indexing)
         return CycleOutput(w.time, CONTROLLER_JOINTS, w.q, w.qd, effort, self.io.states, w.speed_scaling, decisions,
-                           feedback, results)
+                           feedback, results, self.program_running)
 
     # ------------------------------------------------------------------------------------------------ report
     def _report_motion(self) -> dict[str, Any]:
@@ -201,8 +265,17 @@ class DriverStation(ServerCore["ServoWorld"]):
                 "goals": self.records.summary(),
                 "goal_records": [g.as_dict() for g in self.records.goals],
                 "io_calls": list(self.records.io_calls),
-                "halts": [h.as_dict() for h in self.records.halts]}
+                "halts": [h.as_dict() for h in self.records.halts],
+                "program": list(self.records.program)}
 
     def _report_final(self) -> dict[str, Any]:
-        return {"goal_active": self.follower.active is not None, "program_running": self.follower.running,
+        return {"goal_active": self.follower.active is not None, "program_running": self.program_running,
+                "controllers": self._controller_states(),
+                "digital_outputs_on": [pin for pin, on in enumerate(self.io.states.digital_out) if on],
                 "speed_scaling": round(self.world.speed_scaling, 6)}
+
+    def _controller_states(self) -> dict[str, str]:
+        cm = self.controllers
+        if isinstance(cm, Ros1ControllerManager):
+            return dict(cm.states)
+        return {c.name: state for c, state in cm.listing()}
