@@ -77,6 +77,7 @@ class DriverSolveConfig:
     rest_timeout_s: float = 3.0
     poll_s: float = 0.002
     program_wait_s: float = 0.5
+    cancel_wait_s: float = 5.0
 
 
 @dataclass(frozen=True)
@@ -196,7 +197,9 @@ class _Solve:
     def _cancel(self, handle: GoalHandle) -> None:
         if not handle.done():
             handle.cancel()
-            self.sleep(1.0, handle.done)
+            # A goal still in flight (sent, not yet accepted) is canceled once the driver accepts it: leaving
+            # before then would let the arm run it with nobody to stop it (1 s was short on a loaded machine).
+            self.sleep(self.cfg.cancel_wait_s, handle.done)
 
     def output(self, pin: int, on: bool, key: str) -> None:
         """``set_io`` digital output ``pin`` (the calibration's ``io.<key>``) on or off."""
