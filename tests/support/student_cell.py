@@ -43,15 +43,16 @@ def write_student_station(path: Path, base: str = "lab_real") -> Station:
     return load_station(path)
 
 
-def teach_session(child: Any, base: Station, hidden: Station, suction_at: int = 0) -> dict[str, Any]:
+def teach_session(child: Any, base: Station, hidden: Station, suction_at: int = 0,
+                  max_poses: int = 12) -> dict[str, Any]:
     """Teach every pose the guidance names, through teach's pseudo-terminal ``child``: ``g``, jog to the hidden
     contact (plus :data:`ERRORS_MM`), Enter; at pose ``suction_at`` also ``v`` (suction on: the block must be held)
-    and ``v`` again (off); then ``f``. Returns what the operator saw: the poses taught, the suction lines."""
+    and ``v`` again (off); then ``f`` (after ``max_poses`` poses at the latest). Returns what the operator saw: the poses taught, the suction lines."""
     op = Operator(child, base, hidden)
     seen: dict[str, Any] = {"poses": [], "suction": []}
     op.expect(r"next: [^\n]*\n")
     named = child.after
-    for i in range(12):
+    for i in range(max_poses):
         match = re.search(r"next: tower (\d) height (\d)", named)
         if match is None:
             break
