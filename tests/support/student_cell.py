@@ -70,3 +70,37 @@ def teach_session(child: Any, base: Station, hidden: Station, suction_at: int = 
 
 
 __all__ = ["ERRORS_MM", "ROW_TURN_DEG", "TOWER_MOVES_MM", "teach_session", "write_student_station"]
+
+
+def main() -> int:
+    """``python -m tests.support.student_cell DIR N [TEACH OPTIONS...]``: teach (through a pseudo-terminal) the station
+    of ``DIR/student.yaml`` at most N poses, with ``teach --base lab_real -o DIR/taught.yaml --table
+    DIR/lab2_data.yaml --station-out DIR/station.yaml TEACH OPTIONS``; writes ``DIR/transcript.txt`` and prints what
+    the operator saw as one JSON line (the exit status in it)."""
+    import json
+    import sys
+
+    import pexpect
+
+    from tests.support.teach_operator import screen_text
+
+    folder, n, extra = Path(sys.argv[1]), int(sys.argv[2]), sys.argv[3:]
+    argv = ["-m", "ur3hanoi.cli", "teach", "--base", "lab_real", "-o", str(folder / "taught.yaml"), "--table",
+            str(folder / "lab2_data.yaml"), "--station-out", str(folder / "station.yaml"), *extra]
+    with (folder / "raw.txt").open("w") as raw:
+        child = pexpect.spawn(sys.executable, argv, encoding="utf-8", dimensions=(30, 150), timeout=60)
+        child.logfile_read = raw
+        try:
+            seen = teach_session(child, load_station("lab_real"), load_station(folder / "student.yaml"),
+                                 max_poses=n)
+            child.expect(pexpect.EOF, timeout=180)
+        finally:
+            child.close(force=True)
+    seen["exit"] = child.exitstatus
+    (folder / "transcript.txt").write_text(screen_text((folder / "raw.txt").read_bytes().decode()))
+    print(json.dumps(seen))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -15,13 +15,15 @@ line connects it and hands it in, as for the course's topics. This module import
 
 from __future__ import annotations
 
+import dataclasses
+import time
 from collections.abc import Collection
 from typing import Protocol
 
 from ur3hanoi.errors import DriverError
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.teach.driver import Driver, DriverNames
-from ur3hanoi.teach.session import Teacher
+from ur3hanoi.teach.session import ARRIVAL_MARGIN_S, Teacher
 from ur3hanoi.teach.taught_file import TaughtFile
 
 SUCTION_KEY = "v"
@@ -37,6 +39,10 @@ class UrDriver(Driver, Protocol):
 
     def jog_problem(self) -> str:
         """Why a jog goal cannot be sent now ("" when it can)."""
+        ...
+
+    def goal_running(self) -> bool:
+        """True while the last jog goal has no result."""
         ...
 
     def goal_problem(self) -> str:
@@ -86,6 +92,9 @@ class UrTeacher(Teacher):
         return super()._motion_allowed()
 
     def tick(self) -> list[str]:
+        if self.move is not None and self.driver.goal_running():
+            # The goal's own time runs with the pendant's slider: wait for its result, not for the jog caps' time.
+            self.move = dataclasses.replace(self.move, deadline=time.monotonic() + ARRIVAL_MARGIN_S)
         lines = super().tick()
         problem = self.driver.goal_problem()
         if problem and self.move is not None:

@@ -17,6 +17,8 @@ from ur3hanoi.interface.urdriver.cell import JointHistory
 
 PROGRAM_RUNNING = "/io_and_status_controller/robot_program_running"
 """The ROS 2 driver's latched ``std_msgs/Bool``: whether the External Control program runs."""
+GRAPH_WAIT_S = 2.0
+"""[s] how long :meth:`RclpyCellLink.simulated` waits for the graph to name the driver's node."""
 
 
 class RclpyCellLink(RclpyDriverTransport):
@@ -44,6 +46,15 @@ class RclpyCellLink(RclpyDriverTransport):
         return self._program
 
     def simulated(self) -> bool:
+        """True when the node publishing ``/joint_states`` is ur3hanoi's station (the graph learns a node's name
+        after its topics: waits for it, at most :data:`GRAPH_WAIT_S`)."""
+        import time
+
         from ur3hanoi.interface.ros2.ur_station import NODE_NAME
 
-        return NODE_NAME in self.node.get_node_names()
+        end = time.monotonic() + GRAPH_WAIT_S
+        while True:
+            nodes = {i.node_name for i in self.node.get_publishers_info_by_topic(self.names.joint_states)}
+            if (nodes and "_NODE_NAME_UNKNOWN_" not in nodes) or time.monotonic() > end:
+                return NODE_NAME in nodes
+            time.sleep(0.05)

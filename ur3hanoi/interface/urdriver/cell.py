@@ -160,6 +160,10 @@ class DriverArm:
             return f"jog refused: {PROGRAM_STOPPED}; recording needs no program (move the arm in freedrive)"
         return ""
 
+    def goal_running(self) -> bool:
+        """True while the last jog goal has no result (the controller's time runs with the speed slider)."""
+        return self.goal is not None and not self.goal.done()
+
     def goal_problem(self) -> str:
         """How the last jog goal failed, once ("" while it runs or when it succeeded)."""
         goal = self.goal
