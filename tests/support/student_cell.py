@@ -47,7 +47,8 @@ def teach_session(child: Any, base: Station, hidden: Station, suction_at: int = 
                   max_poses: int = 12) -> dict[str, Any]:
     """Teach every pose the guidance names, through teach's pseudo-terminal ``child``: ``g``, jog to the hidden
     contact (plus :data:`ERRORS_MM`), Enter; at pose ``suction_at`` also ``v`` (suction on: the block must be held)
-    and ``v`` again (off); then ``f`` (after ``max_poses`` poses at the latest). Returns what the operator saw: the poses taught, the suction lines."""
+    and ``v`` again (off); then ``f`` (after ``max_poses`` poses at the latest). Returns what the operator saw: the
+    poses taught, the suction lines."""
     op = Operator(child, base, hidden)
     seen: dict[str, Any] = {"poses": [], "suction": []}
     op.expect(r"next: [^\n]*\n")

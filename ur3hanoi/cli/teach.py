@@ -177,15 +177,15 @@ def _session(args: argparse.Namespace, base: Station, base_label: str, taught: T
     from ur3hanoi.teach.session import Teacher
 
     arm, names = _connect(args, base)
-    teacher = None
+    teacher: Teacher | None = None
     try:
         accept = {(t - 1, h - 1) for t, h in args.accept or ()}
-        kind = Teacher
         if args.driver == "ur":
             from ur3hanoi.teach.ur_driver import UrTeacher
 
-            kind = UrTeacher
-        teacher = kind(base, base_label, taught, arm, names, args.start - 1, accept)
+            teacher = UrTeacher(base, base_label, taught, arm, names, args.start - 1, accept)
+        else:
+            teacher = Teacher(base, base_label, taught, arm, names, args.start - 1, accept)
         if args.record_now is not None:
             _record_now(teacher, args.record_now, args.wait)
             return exit_codes.OK, teacher.taught
