@@ -81,6 +81,8 @@ def test_the_copy_is_linted_and_kept(package_copy: Path) -> None:
     ("io/cache.py", "from ur3hanoi import __version__", "Layers"),  # the package face stands on every layer
     ("version.py", "import ur3hanoi", "loose modules"),
     ("interface/ros2/dds.py", "from ur3hanoi.interface.ros1 import env", "ROS 1 and ROS 2"),
+    ("interface/urdriver/station.py", "from ur3hanoi.interface.course import controller", "The two protocols' cores"),
+    ("interface/common/inbox.py", "import ur3hanoi.interface.course.station", "Inside interface"),
     ("plan/types.py", "from ur3hanoi.plan.motion import ruckig", "Inside plan"),
     ("robot/dh.py", "def _f():\n    from ur3hanoi.robot.model import Ur3Model", "Inside robot"),  # a bounce back
     ("station/calibration.py", "def _f():\n    from ur3hanoi.station import grid", "No import cycles"),

@@ -12,8 +12,8 @@ Processes ur3hanoi starts (each stopped on its parent's every exit path: normal 
 - the roscore guard (:mod:`ur3hanoi.interface.ros1.guard`, own session): the end of file on its stdin pipe (the station
   closed it or died), SIGINT or SIGTERM stop it; it stops rosmaster/roscore, which starts with SIGINT and SIGTERM at
   their defaults and dies with the guard;
-- the station's rendering process (:mod:`ur3hanoi.interface.render`, ``spawn``): its pipe, SIGTERM, its parent's death;
-  it ignores SIGINT on purpose (a Ctrl-C must not cut the video short: the station finishes it);
+- the station's rendering process (:mod:`ur3hanoi.interface.common.render`, ``spawn``): its pipe, SIGTERM, its parent's
+  death; it ignores SIGINT on purpose (a Ctrl-C must not cut the video short: the station finishes it);
 - the OpenGL probes (:func:`ur3hanoi.opengl.probe`: a ``python -c`` that renders one frame, before a command
   renders): waited for, killed by :func:`subprocess.run` on its timeout or on any exception (a Ctrl-C, SIGTERM
   raised by :func:`sigterm_raises`), and dies with its parent (:func:`child_start`, its first act: no

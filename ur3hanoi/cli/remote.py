@@ -95,7 +95,7 @@ def check_station_outputs(args: argparse.Namespace, default_calibration: str) ->
 
 
 def station_options(args: argparse.Namespace, default_calibration: str, report: Path | None) -> dict[str, Any]:
-    """The :class:`ur3hanoi.interface.server.ServerOptions` fields of the common options (numbers from 0)."""
+    """The :class:`ur3hanoi.interface.common.station.ServerOptions` fields of the common options (numbers from 0)."""
     return {"calibration": args.calibration or default_calibration, "start": args.start - 1,
             "n_blocks": args.blocks, "removed": None if args.remove_block is None else args.remove_block - 1,
             "drop_on_grasp": None if args.drop_on_grasp is None else args.drop_on_grasp - 1, "seed": args.seed,
@@ -205,13 +205,13 @@ def say_for(args: argparse.Namespace) -> Callable[[str], None]:
 
 def drive(args: argparse.Namespace, arm: Any, job: SolveJob, connected: str,
           outcome: dict[str, object]) -> int:
-    """Connect ``arm`` (a :class:`ur3hanoi.interface.client.TopicArm`), say ``connected``, run the lab's solve,
+    """Connect ``arm`` (a :class:`ur3hanoi.interface.course.client.TopicArm`), say ``connected``, run the lab's solve,
     close the arm; print the outcome (one JSON object with ``--json``). A suction fault is re-raised (exit 3)
     after its outcome is printed."""
     import json
 
     from ur3hanoi.errors import SuctionFaultError
-    from ur3hanoi.interface.solve import LabSolveConfig, run_lab_solve
+    from ur3hanoi.interface.course.solve import LabSolveConfig, run_lab_solve
 
     say = say_for(args)
     try:

@@ -18,7 +18,7 @@ from ur3hanoi.cli import driver, remote
 from ur3hanoi.cli.common import DEFAULT_CALIBRATION
 
 if TYPE_CHECKING:
-    from ur3hanoi.interface.ros1.server import RosServer
+    from ur3hanoi.interface.ros1.server import RosStation
 
 _STATION_HELP = "run the MuJoCo station as the course's ROS driver (ur3/command, position, gripper_input)"
 _STATION_DESCRIPTION = (
@@ -68,7 +68,7 @@ def _add_station(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_run_station)
 
 
-def _node(args: argparse.Namespace, report_file: Path | None) -> RosServer:
+def _node(args: argparse.Namespace, report_file: Path | None) -> RosStation:
     """The station node: the course's topics, or the UR driver's interface (``--driver ur``)."""
     from ur3hanoi.interface.ros1.server import RosServer, RosServerOptions
 

@@ -1,33 +1,24 @@
-"""The transports: what a lab program talks to (the server: ur3hanoi's MuJoCo arm behind the course's topics) and
-the client that drives a driver (the course's, on the real arm, or the server), independent of the middleware.
+"""The transports: two protocols on two middlewares. What a lab program talks to (a station: ur3hanoi's MuJoCo arm
+behind a protocol's topics) and the client that drives a driver (the course's, on the real arm, or a station).
+
+The two protocols' cores, middleware-neutral, siblings that never import each other:
+
+- :mod:`ur3hanoi.interface.course`: the course's topics (``ur3/command``, ``ur3/position``, ``ur3/gripper_input``
+  and the ROS 2 bridge's ``ur3e/*``): the ``movej`` station, the command checks, the client
+  (:class:`~ur3hanoi.interface.course.client.TopicArm`) and the lab program's solve.
+- :mod:`ur3hanoi.interface.urdriver`: the official UR driver's interface (``--driver ur``): the scaled trajectory
+  controller, IO, the station, the plan as goals and the client's solve.
+
+What both use, in :mod:`ur3hanoi.interface.common`: the station's real-time loop without a protocol
+(:class:`~ur3hanoi.interface.common.station.ServerCore`: options, inbox, control cycle, report, rendering), the
+real-time schedule, the bounded inbox, rate-limited log lines, the rendering process, the command error and how a
+move is named on the log.
 
 The ROS 1 binding (:mod:`ur3hanoi.interface.ros1`, rospy) and the ROS 2 binding (:mod:`ur3hanoi.interface.ros2`,
-Cyclone DDS) share everything here and add only their transport; they never import each other. Nothing in this
-package imports rospy or a DDS library; importing it imports nothing heavy (MuJoCo only with the simulated arm,
-:class:`ur3hanoi.sim.MoveJWorld`). The command line still calls a server a "station" (``ros-station``): the word is
-the lab's; in the code a station is the calibrated layout (:mod:`ur3hanoi.station`).
+Cyclone DDS for the course's topics, rclpy for the UR driver's) bind both protocols and add only their transport;
+they never import each other. Nothing in the cores or ``common`` imports rospy or a DDS library; importing them
+imports nothing heavy (MuJoCo only with the simulated arm). The command line still calls a server a "station"
+(``ros-station``): the word is the lab's; the calibrated layout is :mod:`ur3hanoi.station`.
 
-Server side:
-
-- :mod:`~ur3hanoi.interface.server`: :class:`~ur3hanoi.interface.server.ServerCore`, the node without its
-  transport: options, the control cycle, the report.
-- :mod:`~ur3hanoi.interface.controller`: the UR controller's command FIFO, ``isReady`` and the settle
-  measurements (:class:`~ur3hanoi.interface.controller.Controller`); each move runs on
-  :class:`ur3hanoi.sim.MoveJWorld` through the servo law ``ur3hanoi solve`` uses.
-- :mod:`~ur3hanoi.interface.command`: which command messages the server executes or refuses.
-- :mod:`~ur3hanoi.interface.inbox`: what the transport's threads hand to the control loop, bounded.
-- :mod:`~ur3hanoi.interface.realtime`: the real-time schedule, its lag and the stop signals.
-- :mod:`~ur3hanoi.interface.render`: ``--frames``/``--video`` of a server in a separate low-priority process.
-- :mod:`~ur3hanoi.interface.lograte`: log lines a flood cannot multiply (one per topic and second, with counts).
-- :mod:`~ur3hanoi.interface.errors`: :class:`~ur3hanoi.interface.errors.CommandError`.
-
-The official UR driver's interface (``--driver ur``), middleware-neutral as well: :mod:`ur3hanoi.interface.urdriver`
-(the scaled trajectory controller, IO, the station on :class:`~ur3hanoi.interface.server.ServerCore`, the plan as
-goals and the client's solve); the bindings' ``ur_*`` modules serve and drive it.
-
-Client side:
-
-- :mod:`~ur3hanoi.interface.client`: the move-and-wait and suction feedback over three topics,
-  :class:`~ur3hanoi.interface.client.TopicArm` (errors: :class:`ur3hanoi.errors.DriverError`).
-- :mod:`~ur3hanoi.interface.solve`: the lab program's solve with suction checks and halt (:func:`run_lab_solve`).
+Layers (``pyproject.toml``): ``ros1 | ros2`` > ``course | urdriver`` > ``common``.
 """

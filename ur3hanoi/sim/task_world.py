@@ -7,8 +7,8 @@ its suction cup and blocks, and what happens to them (:class:`WorldEvent`).
 injection, where they are). Its subclasses say where each control period's joint reference comes from:
 :class:`ur3hanoi.sim.world.MoveJWorld` (the course's ``movej`` commands) and
 :class:`ur3hanoi.sim.servo_world.ServoWorld` (a streaming trajectory controller's targets, the official UR driver).
-Nothing here knows ROS or the wall clock: the servers (:mod:`ur3hanoi.interface.server`) step a world once per period
-in real time, tests as fast as they like.
+Nothing here knows ROS or the wall clock: the servers (:mod:`ur3hanoi.interface.common.station`) step a world once per
+period in real time, tests as fast as they like.
 
 Blocks are numbered from 0 here (0 = bottom/green); the ROS topics and the report number them from 1. Removed
 blocks are parked on the floor beside the table ("off-grid"), so a respawn brings them back.

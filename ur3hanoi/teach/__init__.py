@@ -18,5 +18,5 @@ Module map (one concept each):
 - :mod:`~ur3hanoi.teach.interactive`: the keys and the loop of the terminal session.
 
 This package sits beside the transports (it imports none of them): the command line connects a driver client
-(:class:`ur3hanoi.interface.client.TopicArm`) and passes it in.
+(:class:`ur3hanoi.interface.course.client.TopicArm`) and passes it in.
 """

@@ -2,7 +2,7 @@
 times, a joint move sent at a speed of teach's own, whether it is ur3hanoi's simulated station (no pendant there),
 and the problem of the last malformed position message.
 
-:class:`ur3hanoi.interface.client.TopicArm` (on rospy or Cyclone DDS) is such a driver; the command line connects
+:class:`ur3hanoi.interface.course.client.TopicArm` (on rospy or Cyclone DDS) is such a driver; the command line connects
 one and passes it in. This module imports no middleware.
 """
 

@@ -63,7 +63,7 @@ def test_positions_are_kept_with_their_arrival_times_and_a_malformed_one_is_name
 
     import numpy as np
 
-    from ur3hanoi.interface.client import HISTORY_S
+    from ur3hanoi.interface.course.client import HISTORY_S
 
     arm = RosArm(master_uri="http://x:1", log=lambda s: None)
     t0 = time.monotonic()

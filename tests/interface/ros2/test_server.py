@@ -147,7 +147,7 @@ HONEST_REFUSALS = [
 def test_absurd_commands_are_refused_with_a_log_line_and_the_next_command_runs() -> None:
     """Honest timing: wrong length, NaN, v = a = 1e-9 and 5e-324, a 76 s move: each refused with its reason, no
     motion, one log line at once and one summary naming the others; then a valid command runs."""
-    from ur3hanoi.interface.controller import MAX_MOVE_S
+    from ur3hanoi.interface.course.controller import MAX_MOVE_S
 
     logged: list[str] = []
     st = Ros2Server(Ros2ServerOptions(timing="honest"), out=lambda s: None, log=logged.append)

@@ -12,7 +12,7 @@ import pytest
 
 from tests.support.driver_helpers import goal, send, station
 from ur3hanoi.errors import DriverError, SuctionFaultError
-from ur3hanoi.interface.solve import describe_move
+from ur3hanoi.interface.common.moves import describe_move
 from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverState
 from ur3hanoi.interface.urdriver.facts import ErrorCode
 from ur3hanoi.interface.urdriver.loopback import LoopbackTransport

@@ -1,8 +1,8 @@
 """A rospy client of the course's interface: ``ur3/command`` out, ``ur3/position`` and ``ur3/gripper_input`` in.
 
-:class:`RosArm` is the transport-neutral :class:`ur3hanoi.interface.client.TopicArm` (moves, waits, suction checks,
-timeouts) bound to rospy: it registers with the master and waits for the driver before the first command (a rospy
-publisher drops messages until a subscriber is connected); the callbacks run in rospy's threads. The master is
+:class:`RosArm` is the transport-neutral :class:`ur3hanoi.interface.course.client.TopicArm` (moves, waits, suction
+checks, timeouts) bound to rospy: it registers with the master and waits for the driver before the first command (a
+rospy publisher drops messages until a subscriber is connected); the callbacks run in rospy's threads. The master is
 watched (:class:`~ur3hanoi.interface.ros1.watch.MasterWatch`): once it is gone, the next wait raises :class:`RosError`
 (one line, exit 2), as when the positions stop.
 """
@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.interface.client import ArmConfig, TopicArm, Topics
+from ur3hanoi.interface.course.client import ArmConfig, TopicArm, Topics
 from ur3hanoi.interface.ros1.errors import RosError
 
 TOPICS = Topics(command="ur3/command", position="ur3/position", gripper="ur3/gripper_input")

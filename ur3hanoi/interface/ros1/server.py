@@ -4,8 +4,8 @@ The node speaks the course's topics and messages exactly (:mod:`ur3hanoi.interfa
 
 - subscribes ``/ur3/command``: each accepted command runs as the controller's ``movej``
   (:mod:`ur3hanoi.robot.movej`, ``v``/``a`` capped at the UR3's limits) after the ones before it
-  (:mod:`ur3hanoi.interface.controller`), switching the suction to ``io_0`` when it starts; malformed commands are
-  refused with a logged error and no motion (:mod:`ur3hanoi.interface.command`);
+  (:mod:`ur3hanoi.interface.course.controller`), switching the suction to ``io_0`` when it starts; malformed commands
+  are refused with a logged error and no motion (:mod:`ur3hanoi.interface.course.command`);
 - publishes ``/ur3/position`` (measured joint angles, ``isReady`` false while moving or not yet within
   0.0005 rad of the destination) and ``/ur3/gripper_input`` (``DIGIN`` bit 0, ``AIN0`` from the suction model)
   every control period (8 ms: 125 Hz, like the course driver);
@@ -14,7 +14,7 @@ The node speaks the course's topics and messages exactly (:mod:`ur3hanoi.interfa
   away; a held block is dropped).
 
 Real time, the bounded inbox, rate-limited logging and the report are the transport-neutral station's
-(:mod:`ur3hanoi.interface.server`); this module binds them to rospy. A roscore is started when none answers at
+(:mod:`ur3hanoi.interface.common.station`); this module binds them to rospy. A roscore is started when none answers at
 ``ROS_MASTER_URI`` (:mod:`ur3hanoi.interface.ros1.master`) and stopped on exit, or when the station dies
 (:mod:`ur3hanoi.interface.ros1.guard`).
 
@@ -25,8 +25,8 @@ connections; nodes started now find the station); a master it did not start, or 
 the station: report written, one error line, exit 2. The report's ``master_events`` records what happened.
 
 A flood cannot stall the loop: the ROS callbacks only append to the bounded inbox
-(:data:`~ur3hanoi.interface.inbox.INBOX_MAX` messages), log lines are rate-limited and the records bounded
-(:class:`~ur3hanoi.interface.server.ServerCore`).
+(:data:`~ur3hanoi.interface.common.inbox.INBOX_MAX` messages), log lines are rate-limited and the records bounded
+(:class:`~ur3hanoi.interface.common.station.ServerCore`).
 
 Listening: the station and the roscore it starts bind and advertise ``host`` (``ROS_IP``), by default
 ``127.0.0.1``: nothing on the lab network can reach them. ``--host ADDR`` (this machine's address on the lab
@@ -36,8 +36,8 @@ not used.
 Output: the ready line and every info line go to ``info`` (the CLI: stderr); standard output carries only the
 JSON report when there is no ``--report`` file.
 
-``--frames``/``--video`` render in a separate low-priority process (:mod:`ur3hanoi.interface.render`, started by
-:meth:`~ur3hanoi.interface.server.ServerCore.rendering`), which drops frames rather than stall the loop.
+``--frames``/``--video`` render in a separate low-priority process (:mod:`ur3hanoi.interface.common.render`, started by
+:meth:`~ur3hanoi.interface.common.station.ServerCore.rendering`), which drops frames rather than stall the loop.
 
 The JSON report (:meth:`RosServer.report`): commands executed (with duration, settle time and rest error),
 refused, suction events, faults, final block positions (tower/height, or none = off-grid), loop timing, rendered
@@ -55,8 +55,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
+from ur3hanoi.interface.common.station import ServerCore, ServerOptions
+from ur3hanoi.interface.course.station import CourseStation
 from ur3hanoi.interface.ros1.errors import RosError
-from ur3hanoi.interface.server import ServerCore, ServerOptions
 
 READY_LINE = "ur3hanoi ros-station: ready"
 """Written (and flushed) on stderr once the node is up: scripts wait for it."""
@@ -66,7 +67,7 @@ NODE_NAME = "ur3hanoi_station"
 
 @dataclass(frozen=True)
 class RosServerOptions(ServerOptions):
-    """What ``ur3hanoi ros-station`` runs: :class:`~ur3hanoi.interface.server.ServerOptions` and
+    """What ``ur3hanoi ros-station`` runs: :class:`~ur3hanoi.interface.common.station.ServerOptions` and
 
     Attributes:
         master_uri: ROS master (None: ``ROS_MASTER_URI``, else http://localhost:11311).
@@ -78,8 +79,11 @@ class RosServerOptions(ServerOptions):
     host: str = "127.0.0.1"
 
 
-class RosServer(ServerCore):
-    """The ``ros-station`` node (see the module docstring). :meth:`run` blocks until stopped.
+class RosStation(ServerCore[Any]):
+    """A station on rospy for either protocol: its master, guard, watch, spawn and remove topics and its loop (see
+    the module docstring); a protocol's binding provides :meth:`_open` (its topics) and :meth:`_ready_detail`
+    (:class:`RosServer`, :class:`ur3hanoi.interface.ros1.ur_server.RosDriverServer`). :meth:`run` blocks until
+    stopped.
 
     Args:
         options: what to run.
@@ -210,6 +214,34 @@ class RosServer(ServerCore):
             raise RosError(self._master_failed)
         return report
 
+    def _run_loop(self, publish: Callable[[], None]) -> None:
+        w, opts = self.world, self.options
+        st = self.station
+        spawned = w.n_blocks - len(w.removed)  # --remove-block leaves one out
+        ready = (f"{READY_LINE} on {self.master_uri}: {st.name}, {spawned} blocks on tower {opts.start + 1}, "
+                 f"{self._ready_detail()} (pid {os.getpid()})")
+        # The ROS callbacks fill the inbox in rospy's threads: nothing to receive here.
+        self.loop(ready, lambda: None, publish,
+                  running=lambda: self._master_failed is None and not self._rospy.is_shutdown())
+
+    def _open(self, rospy: Any) -> Callable[[], None]:
+        """Advertise and subscribe the protocol's topics; returns the publish step of every control cycle."""
+        raise NotImplementedError
+
+    def _ready_detail(self) -> str:
+        """What the ready line says after the station's name and blocks."""
+        raise NotImplementedError
+
+
+class RosServer(RosStation, CourseStation):
+    """The ``ros-station`` node of the course's topics (see the module docstring). :meth:`run` blocks until stopped.
+
+    Args:
+        options: what to run.
+        out: where the ready line and info lines go (default: print to stderr, flushed).
+        report_out: where the JSON report goes without ``options.report`` (default: print to stdout, flushed).
+    """
+
     def _open(self, rospy: Any) -> Callable[[], None]:
         """Advertise and subscribe the course's topics; returns the publish step of every control cycle."""
         from ur3hanoi.interface.ros1.msgs import load_messages
@@ -231,13 +263,3 @@ class RosServer(ServerCore):
         """What the ready line says after the station's name and blocks."""
         w = self.world
         return f"{1.0 / w.config.period_s:g} Hz, suction profile {w.cup.profile.name}"
-
-    def _run_loop(self, publish: Callable[[], None]) -> None:
-        w, opts = self.world, self.options
-        st = self.station
-        spawned = w.n_blocks - len(w.removed)  # --remove-block leaves one out
-        ready = (f"{READY_LINE} on {self.master_uri}: {st.name}, {spawned} blocks on tower {opts.start + 1}, "
-                 f"{self._ready_detail()} (pid {os.getpid()})")
-        # The ROS callbacks fill the inbox in rospy's threads: nothing to receive here.
-        self.loop(ready, lambda: None, publish,
-                  running=lambda: self._master_failed is None and not self._rospy.is_shutdown())

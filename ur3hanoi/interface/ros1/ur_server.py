@@ -3,7 +3,7 @@ MuJoCo.
 
 :class:`RosDriverServer` is the neutral :class:`~ur3hanoi.interface.urdriver.station.DriverStation` (the simulated
 robot under the scaled joint trajectory controller, IO, records) on the ROS 1 station
-(:class:`~ur3hanoi.interface.ros1.server.RosServer`: its master, guard, watch, spawn and remove topics). Names, types
+(:class:`~ur3hanoi.interface.ros1.server.RosStation`: its master, guard, watch, spawn and remove topics). Names, types
 and order are the driver's (:data:`ur3hanoi.interface.urdriver.facts.ROS1`):
 
 - ``/joint_states`` (``sensor_msgs/JointState``, alphabetical joint order, position, velocity, effort) every cycle;
@@ -30,7 +30,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ur3hanoi.interface.ros1.driver_msgs import OFFICIAL_MD5, DriverMessages, load_driver_messages
-from ur3hanoi.interface.ros1.server import RosServer, RosServerOptions
+from ur3hanoi.interface.ros1.server import RosServerOptions, RosStation
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1, ROS1_JOINT_STATE_ORDER
 from ur3hanoi.interface.urdriver.follower import Feedback, Outcome
 from ur3hanoi.interface.urdriver.goal import JointTolerance, Rejection, TrajectoryGoal, TrajectoryPoint
@@ -85,7 +85,7 @@ def goal_from_msg(msg: Any, now: Any) -> TrajectoryGoal:
                           msg.goal_time_tolerance.to_sec(), start)
 
 
-class RosDriverServer(RosServer, DriverStation):
+class RosDriverServer(RosStation, DriverStation):
     """The ``ros-station --driver ur`` node (see the module docstring). :meth:`run` blocks until stopped."""
 
     options: RosDriverOptions

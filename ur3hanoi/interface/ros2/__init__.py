@@ -6,7 +6,7 @@
   default QoS, type hashes in USER_DATA, the node announced on ``ros_discovery_info``).
 - :mod:`~ur3hanoi.interface.ros2.server`: ``ros2-station``, the MuJoCo station as the course bridge.
 - :mod:`~ur3hanoi.interface.ros2.client`: ``ros2-solve``'s arm, driven by
-  :func:`ur3hanoi.interface.solve.run_lab_solve`.
+  :func:`ur3hanoi.interface.course.solve.run_lab_solve`.
 
 The world, command checks, motion, suction, the station's loop and report and the client's move-and-wait are the
 middleware-free :mod:`ur3hanoi.interface`, shared with the ROS 1 binding :mod:`ur3hanoi.interface.ros1`; only the

@@ -1,11 +1,11 @@
 """The arm as seen through the ROS 2 course topics: ``ur3e/command`` out, ``ur3e/position`` and
 ``ur3e/gripper_input`` in (``ros2-station`` or the course's real-robot bridge).
 
-:class:`Ros2Arm` is the transport-neutral :class:`ur3hanoi.interface.client.TopicArm` (moves, waits, suction checks,
-timeouts) bound to Cyclone DDS, so :func:`ur3hanoi.interface.solve.run_lab_solve` drives it with the same suction
-checks and halt as ``ros-solve``. It works in the controller convention like the rest of ur3hanoi and converts at
-the topic (the bridge's course convention by default, :mod:`ur3hanoi.robot.convention`). A move is done when every joint
-is within ``tolerance_rad`` (0.0008 rad, what ENME480 student programs wait for); ``is_ready`` is not used (the
+:class:`Ros2Arm` is the transport-neutral :class:`ur3hanoi.interface.course.client.TopicArm` (moves, waits, suction
+checks, timeouts) bound to Cyclone DDS, so :func:`ur3hanoi.interface.course.solve.run_lab_solve` drives it with the same
+suction checks and halt as ``ros-solve``. It works in the controller convention like the rest of ur3hanoi and converts
+at the topic (the bridge's course convention by default, :mod:`ur3hanoi.robot.convention`). A move is done when every
+joint is within ``tolerance_rad`` (0.0008 rad, what ENME480 student programs wait for); ``is_ready`` is not used (the
 bridge always sends true). ``held`` is ``dig_in`` bit 0. The readers are polled in the waiting loops.
 """
 
@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.interface.client import ArmConfig, TopicArm, Topics
+from ur3hanoi.interface.course.client import ArmConfig, TopicArm, Topics
 from ur3hanoi.robot.convention import from_controller, to_controller
 
 TOPICS = Topics(command="ur3e/command", position="ur3e/position", gripper="ur3e/gripper_input", digital="dig_in",
@@ -27,7 +27,7 @@ TOPICS = Topics(command="ur3e/command", position="ur3e/position", gripper="ur3e/
 
 @dataclass(frozen=True)
 class Ros2ArmConfig(ArmConfig):
-    """How the client commands and waits (:class:`ur3hanoi.interface.client.ArmConfig`); ``tolerance_rad`` is the
+    """How the client commands and waits (:class:`ur3hanoi.interface.course.client.ArmConfig`); ``tolerance_rad`` is the
     ENME480 programs' 0.0008 rad, ``convention`` the topics' joint convention."""
 
     v: float = 1.0

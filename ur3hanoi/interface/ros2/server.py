@@ -21,14 +21,15 @@ command as the UR controller's ``movej`` at the message's ``v``/``a`` (capped at
 ``is_ready`` says whether the arm has arrived, as ``ros-station`` does.
 
 The world, command checks, motion, suction, the real-time loop, the bounded inbox, rate-limited log lines and
-the report are the transport-neutral station's (:class:`ur3hanoi.interface.server.ServerCore`), shared with
+the report are the transport-neutral station's (:class:`ur3hanoi.interface.common.station.ServerCore`), shared with
 ``ros-station``; only the transport (:mod:`ur3hanoi.interface.ros2.dds`) differs: the loop takes at most 50 messages a
 cycle from each DDS reader (whose history is itself bounded by the QoS depth). Refusals are logged at most once
 a second per topic, with counts. The JSON report (SIGINT/SIGTERM, ``duration_s``; SIGUSR1 without stopping)
 has ``ros-station``'s sections plus ``transport``.
 
 ``--frames``/``--video`` render in a separate low-priority process that drops frames rather than stall the loop
-(:meth:`~ur3hanoi.interface.server.ServerCore.rendering`, as ``ros-station``); the report's ``frames`` counts them.
+(:meth:`~ur3hanoi.interface.common.station.ServerCore.rendering`, as ``ros-station``); the report's ``frames`` counts
+them.
 """
 
 from __future__ import annotations
@@ -43,8 +44,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ur3hanoi.errors import InputError
+from ur3hanoi.interface.common.station import ServerOptions
+from ur3hanoi.interface.course.station import CourseStation
 from ur3hanoi.interface.ros2.errors import DdsError
-from ur3hanoi.interface.server import ServerCore, ServerOptions
 from ur3hanoi.robot.convention import from_controller, to_controller
 
 READY_LINE = "ur3hanoi ros2-station: ready"
@@ -66,7 +68,7 @@ TOPIC_REMOVE = "ur3hanoi/remove_block"
 
 @dataclass(frozen=True)
 class Ros2ServerOptions(ServerOptions):
-    """What ``ur3hanoi ros2-station`` runs: :class:`~ur3hanoi.interface.server.ServerOptions` (the calibration
+    """What ``ur3hanoi ros2-station`` runs: :class:`~ur3hanoi.interface.common.station.ServerOptions` (the calibration
     ``ur3e_sim`` by default) and
 
     Attributes:
@@ -95,7 +97,7 @@ def bridge_speed(start: np.ndarray, destination: np.ndarray, duration_s: float =
     return 2.0 * dist / duration_s, 4.0 * dist / (duration_s * duration_s)
 
 
-class Ros2Server(ServerCore):
+class Ros2Server(CourseStation):
     """The ``ros2-station`` node (see the module docstring). :meth:`run` blocks until stopped.
 
     Args:

@@ -22,9 +22,9 @@ Besides: ``ur3hanoi/spawn`` and ``ur3hanoi/remove_block`` (``std_msgs/Int32``) a
 ``ur3hanoi/hold_arm`` (``std_msgs/Float64`` seconds: the arm is held, e.g. to provoke a path-tolerance abort).
 
 Threads: the control loop runs in the main thread on the wall clock (:meth:`ServerCore.loop
-<ur3hanoi.interface.server.ServerCore.loop>`); rclpy's executor runs the callbacks in a thread pool, and they only hand
-work to the station's inbox or wait for what the loop publishes. Loopback only (``ROS_AUTOMATIC_DISCOVERY_RANGE``
-LOCALHOST) unless ``network="lab"``.
+<ur3hanoi.interface.common.station.ServerCore.loop>`); rclpy's executor runs the callbacks in a thread pool, and they
+only hand work to the station's inbox or wait for what the loop publishes. Loopback only
+(``ROS_AUTOMATIC_DISCOVERY_RANGE`` LOCALHOST) unless ``network="lab"``.
 """
 
 from __future__ import annotations

@@ -39,7 +39,7 @@ import numpy as np
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import DriverError, SuctionFaultError
 from ur3hanoi.hanoi import Move, block_colour
-from ur3hanoi.interface.solve import describe_move
+from ur3hanoi.interface.common.moves import describe_move
 from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverTransport, GoalHandle
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, FUN_SET_DIGITAL_OUT
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal

@@ -1,7 +1,7 @@
 """A station that serves the official UR driver's interface (``ros-station --driver ur``), without its transport.
 
-:class:`DriverStation` is a :class:`~ur3hanoi.interface.server.ServerCore` (real-time loop, inbox, rate-limited log,
-report, rendering) whose arm is the simulated UR robot under the driver's scaled joint trajectory controller:
+:class:`DriverStation` is a :class:`~ur3hanoi.interface.common.station.ServerCore` (real-time loop, inbox, rate-limited
+log, report, rendering) whose arm is the simulated UR robot under the driver's scaled joint trajectory controller:
 
 - the robot: :class:`ur3hanoi.sim.servo_world.ServoWorld` (joint limits, its own speed scaling times the slider
   ``speed_scaling``, the servo, suction, blocks);
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.interface.server import ServerCore, ServerOptions
+from ur3hanoi.interface.common.station import ServerCore, ServerOptions
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS
 from ur3hanoi.interface.urdriver.follower import Feedback, Outcome, TrajectoryFollower
 from ur3hanoi.interface.urdriver.goal import Rejection, TrajectoryGoal
@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class DriverStationOptions(ServerOptions):
-    """:class:`~ur3hanoi.interface.server.ServerOptions` and
+    """:class:`~ur3hanoi.interface.common.station.ServerOptions` and
 
     Attributes:
         speed_scaling: the pendant's speed slider, in (0, 1].

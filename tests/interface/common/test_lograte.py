@@ -5,7 +5,7 @@ from __future__ import annotations
 import itertools
 import re
 
-from ur3hanoi.interface.lograte import RateLimitedLog
+from ur3hanoi.interface.common.lograte import RateLimitedLog
 
 
 class Clock:

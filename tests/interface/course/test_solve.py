@@ -1,5 +1,5 @@
-"""The lab program's solve (ur3hanoi.interface.solve): in world time against the simulated station (no ROS), and end
-to end as ``ur3hanoi ros-solve`` against ``ur3hanoi ros-station`` over a real roscore (marked ``ros``)."""
+"""The lab program's solve (ur3hanoi.interface.course.solve): in world time against the simulated station (no ROS), and
+end to end as ``ur3hanoi ros-solve`` against ``ur3hanoi ros-station`` over a real roscore (marked ``ros``)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import pytest
 
 from tests.support.ros_support import final_slots, free_port, requires_ros, ros_env, roscore, run, station, ur3hanoi_cmd
 from ur3hanoi.errors import PuzzleError, SuctionFaultError
-from ur3hanoi.interface.controller import Controller
-from ur3hanoi.interface.solve import run_lab_solve
+from ur3hanoi.interface.course.controller import Controller
+from ur3hanoi.interface.course.solve import run_lab_solve
 from ur3hanoi.sim.world import MoveJWorld
 from ur3hanoi.tables.ik_table import generate_table
 

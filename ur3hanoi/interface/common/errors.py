@@ -1,4 +1,4 @@
-"""Errors of a server (:mod:`ur3hanoi.interface.server`), whatever the middleware.
+"""Errors of a server (:mod:`ur3hanoi.interface.common.station`), whatever the middleware.
 
 A client's errors are :class:`ur3hanoi.errors.DriverError` (the driver cannot be reached, stopped, answers
 wrongly) and its middleware's subclasses (:class:`ur3hanoi.interface.ros1.errors.RosError`,

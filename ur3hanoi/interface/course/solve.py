@@ -6,7 +6,7 @@ lower it **checking it stays held all the way**, suction off, back up; finally h
 block is held where one must be, it halts like the lab asks: suction off, arm home, then
 :class:`~ur3hanoi.errors.SuctionFaultError` (exit code 3) with a one-line message.
 
-The arm is any object with the :class:`Arm` methods: :class:`ur3hanoi.interface.client.TopicArm`, bound to ROS 1
+The arm is any object with the :class:`Arm` methods: :class:`ur3hanoi.interface.course.client.TopicArm`, bound to ROS 1
 (``ros-station`` or the real UR3) or ROS 2 (``ros2-station`` or the course's UR3e bridge); tests use a fake.
 """
 
@@ -20,6 +20,7 @@ from typing import Protocol
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.errors import PuzzleError, SuctionFaultError
 from ur3hanoi.hanoi import Move, block_colour, solve_hanoi
+from ur3hanoi.interface.common.moves import describe_move
 
 
 class Arm(Protocol):
@@ -69,12 +70,6 @@ class _BlockLostError(Exception):
     def __init__(self, kind: str) -> None:
         super().__init__(kind)
         self.kind = kind
-
-
-def describe_move(move: Move) -> str:
-    """``block 3 (red): tower 1 height 3 -> tower 3 height 1`` (numbered from 1)."""
-    return (f"block {move.block + 1} ({block_colour(move.block)}): tower {move.from_tower + 1} height "
-            f"{move.from_height + 1} -> tower {move.to_tower + 1} height {move.to_height + 1}")
 
 
 def run_lab_solve(arm: Arm, Q: FloatArray, home: FloatArray, start: int, end: int, n_blocks: int,

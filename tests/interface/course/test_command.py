@@ -7,8 +7,8 @@ import math
 import pytest
 
 from ur3hanoi.errors import Ur3HanoiError
-from ur3hanoi.interface.command import parse_command
-from ur3hanoi.interface.errors import CommandError
+from ur3hanoi.interface.common.errors import CommandError
+from ur3hanoi.interface.course.command import parse_command
 from ur3hanoi.robot.model import Q_HOME_LAB, JointLimits
 
 LIM = JointLimits.ur3(elbow_limit=math.pi)

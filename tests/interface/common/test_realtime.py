@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from ur3hanoi.interface.realtime import LAG_BINS_MS, LoopTiming, RealTimeLoop
+from ur3hanoi.interface.common.realtime import LAG_BINS_MS, LoopTiming, RealTimeLoop
 
 
 def test_loop_timing_counts_lag_into_its_histogram() -> None:

@@ -1,6 +1,6 @@
-"""The transport-neutral station (ur3hanoi.interface.server) through both bindings, in process (no ROS, no DDS):
-a command flood is counted in full while the report, the records and the log lines stay bounded; the render sink
-(--frames/--video) writes what the report counts."""
+"""The transport-neutral station (ur3hanoi.interface.common.station) through the course's station and both bindings,
+in process (no ROS, no DDS): a command flood is counted in full while the report, the records and the log lines stay
+bounded; the render sink (--frames/--video) writes what the report counts."""
 
 from __future__ import annotations
 
@@ -14,9 +14,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from ur3hanoi.interface.common.station import ServerCore, ServerOptions
+from ur3hanoi.interface.course.station import CourseStation
 from ur3hanoi.interface.ros1.server import RosServer, RosServerOptions
 from ur3hanoi.interface.ros2.server import Ros2Server, Ros2ServerOptions
-from ur3hanoi.interface.server import ServerCore, ServerOptions
 
 Station = tuple[ServerCore, list[float]]
 
@@ -60,10 +61,10 @@ def test_the_report_does_not_grow_with_the_number_of_commands(make: Callable[[li
 @pytest.mark.parametrize("kind", ["frames", "video"])
 def test_the_render_sink_writes_what_the_report_counts(kind: str, tmp_path: Path,
                                                        monkeypatch: pytest.MonkeyPatch) -> None:
-    """ServerCore without a transport, 2 s of real time with one move of joint 1 and ``frames`` or ``video``: the
-    rendering process writes as many frames as the report says it rendered (the rest dropped, not waited for),
-    the pictures are not blank and show the arm moving. Without a display or MUJOCO_GL, the process chooses its
-    OpenGL platform itself (ur3hanoi.opengl), as a script using the library would have it."""
+    """ServerCore (the course's station) without a transport, 2 s of real time with one move of joint 1 and
+    ``frames`` or ``video``: the rendering process writes as many frames as the report says it rendered (the rest
+    dropped, not waited for), the pictures are not blank and show the arm moving. Without a display or MUJOCO_GL,
+    the process chooses its OpenGL platform itself (ur3hanoi.opengl), as a script using the library would have it."""
     import imageio_ffmpeg
     from PIL import Image
 
@@ -72,7 +73,7 @@ def test_the_render_sink_writes_what_the_report_counts(kind: str, tmp_path: Path
     for name in (MUJOCO_GL, VERIFIED, "DISPLAY", "WAYLAND_DISPLAY"):
         monkeypatch.delenv(name, raising=False)
     out = tmp_path / ("run.mp4" if kind == "video" else "frames")
-    node = ServerCore(ServerOptions(duration_s=2.0, **{kind: out}), out=lambda _s: None, report_out=lambda _s: None)
+    node = CourseStation(ServerOptions(duration_s=2.0, **{kind: out}), out=lambda _s: None, report_out=lambda _s: None)
     q = [float(x) for x in node.world.q]
     node.on_command(SimpleNamespace(destination=[q[0] + 0.8, *q[1:]], v=3.0, a=6.0, io_0=False))
     try:
@@ -107,7 +108,7 @@ def test_the_render_sink_writes_what_the_report_counts(kind: str, tmp_path: Path
 def test_a_station_behind_real_time_says_so() -> None:
     """A publish step that stalls the loop 0.45 s once: one warning line naming how far behind it is."""
     logged: list[str] = []
-    node = ServerCore(ServerOptions(duration_s=0.6), out=logged.append, report_out=lambda _s: None)
+    node = CourseStation(ServerOptions(duration_s=0.6), out=logged.append, report_out=lambda _s: None)
     stalls = iter([0.45])
 
     def publish() -> None:

@@ -1,7 +1,7 @@
 """The client side of a remote station, whatever the middleware: command a joint move, wait until the arm is
 there, read the suction feedback.
 
-:class:`TopicArm` implements :class:`ur3hanoi.interface.solve.Arm` over three topics (a command out, the position
+:class:`TopicArm` implements :class:`ur3hanoi.interface.course.solve.Arm` over three topics (a command out, the position
 and the gripper input in) the way the lab's ``move_arm``/``gripper`` do, with the gaps closed: a move returns once
 every joint is within ``tolerance_rad`` of the destination and re-publishes the command every ``republish_s`` like
 the lab's, but gives up with an error after ``move_timeout_s`` instead of hanging, and at once when the position

@@ -12,7 +12,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ur3hanoi.interface.errors import CommandError
+from ur3hanoi.interface.common.errors import CommandError
 from ur3hanoi.robot.model import JointLimits
 from ur3hanoi.robot.registry import N_JOINTS
 

@@ -1,32 +1,35 @@
-"""A server (``ros-station``, ``ros2-station``) without its transport: options, inbox, control cycle, report.
+"""A station (``ros-station``, ``ros2-station``, either protocol) without its protocol and transport: options, inbox,
+control cycle, report.
 
-:class:`ServerCore` holds the simulated arm and blocks of a station (:class:`~ur3hanoi.sim.world.MoveJWorld` driven by a
-:class:`~ur3hanoi.interface.controller.Controller`) and runs it in real time; a transport binding
+:class:`ServerCore` holds the simulated arm and blocks of a station and runs it in real time; a protocol's core
+subclasses it with the world and what drives it (the course's ``movej`` controller:
+:class:`ur3hanoi.interface.course.station.CourseStation`; the UR driver's trajectory controller:
+:class:`ur3hanoi.interface.urdriver.station.DriverStation`), and a transport binding
 (:class:`ur3hanoi.interface.ros1.server.RosServer` on rospy, :class:`ur3hanoi.interface.ros2.server.Ros2Server` on
-Cyclone DDS) subclasses it, opens its topics and passes what arrives to :meth:`ServerCore.on_command` (and
-:meth:`~ServerCore.on_spawn`, :meth:`~ServerCore.on_remove`), and publishes the feedback in :meth:`ServerCore.loop`'s
-``publish`` step.
+Cyclone DDS, and their ``ur_*`` counterparts) subclasses that, opens its topics and passes what arrives to
+:meth:`ServerCore.on_command` (and :meth:`~ServerCore.on_spawn`, :meth:`~ServerCore.on_remove`), and publishes the
+feedback in :meth:`ServerCore.loop`'s ``publish`` step.
 
-Real time: one world step per control period on the wall clock (:class:`~ur3hanoi.interface.realtime.RealTimeLoop`:
-an absolute schedule, the lag of every cycle measured).
+Real time: one world step per control period on the wall clock
+(:class:`~ur3hanoi.interface.common.realtime.RealTimeLoop`: an absolute schedule, the lag of every cycle measured).
 
-A flood cannot stall the loop: callbacks only append to a bounded inbox (:class:`~ur3hanoi.interface.inbox.Inbox`,
-:data:`~ur3hanoi.interface.inbox.INBOX_MAX` messages; more are refused as "inbox full" and counted); each cycle
-handles at most what the inbox held when it started; refusals and topic messages are logged through
-:class:`~ur3hanoi.interface.lograte.RateLimitedLog` (at most one line per topic and second, with counts); the records
-are bounded (:mod:`ur3hanoi.interface.controller`, world events), so memory and the report do not grow with the number
-of commands.
+A flood cannot stall the loop: callbacks only append to a bounded inbox
+(:class:`~ur3hanoi.interface.common.inbox.Inbox`, :data:`~ur3hanoi.interface.common.inbox.INBOX_MAX` messages; more
+are refused as "inbox full" and counted); each cycle handles at most what the inbox held when it started; refusals
+and topic messages are logged through :class:`~ur3hanoi.interface.common.lograte.RateLimitedLog` (at most one line
+per topic and second, with counts); the records are bounded (the protocol's controller, world events), so memory and
+the report do not grow with the number of commands.
 
 Rendering (``frames``/``video`` options, ``--frames``/``--video``): :meth:`ServerCore.rendering` starts a
-separate low-priority process (:class:`ur3hanoi.interface.render.FrameOutput`); :meth:`ServerCore.loop` offers it the
-joint state once per frame period of world time (dropped while it is busy, so the loop keeps real time), and the
-report's ``frames`` says how many were rendered and dropped.
+separate low-priority process (:class:`ur3hanoi.interface.common.render.FrameOutput`); :meth:`ServerCore.loop` offers
+it the joint state once per frame period of world time (dropped while it is busy, so the loop keeps real time), and
+the report's ``frames`` says how many were rendered and dropped.
 
-The JSON report (:meth:`ServerCore.report`): commands executed (with duration, settle time and rest error),
-refused, suction events, faults, spawns, final block positions (tower/height, or none = off-grid), loop timing,
-rendered frames, plus the binding's own sections. It is written on SIGINT/SIGTERM and at the end of
-``duration_s``, and on SIGUSR1 without stopping: to ``options.report`` (atomically) or, without it, to
-``report_out``.
+The JSON report (:meth:`ServerCore.report`): the protocol's motion sections (the course's: commands executed with
+duration, settle time and rest error, and refused), suction events, faults, spawns, final block positions
+(tower/height, or none = off-grid), loop timing, rendered frames, plus the binding's own sections. It is written on
+SIGINT/SIGTERM and at the end of ``duration_s``, and on SIGUSR1 without stopping: to ``options.report`` (atomically)
+or, without it, to ``report_out``.
 """
 
 from __future__ import annotations
@@ -40,10 +43,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
 
 from ur3hanoi.errors import InputError
-from ur3hanoi.interface.errors import CommandError
-from ur3hanoi.interface.inbox import INBOX_MAX, Inbox
-from ur3hanoi.interface.realtime import RealTimeLoop
-from ur3hanoi.interface.render import FrameOutput
+from ur3hanoi.interface.common.errors import CommandError
+from ur3hanoi.interface.common.inbox import INBOX_MAX, Inbox
+from ur3hanoi.interface.common.realtime import RealTimeLoop
+from ur3hanoi.interface.common.render import FrameOutput
 
 if TYPE_CHECKING:
     from ur3hanoi.sim.config import SimConfig
@@ -120,13 +123,14 @@ def _spawn_or_remove(core: ServerCore[Any], kind: str, payload: Any) -> None:
 
 
 class ServerCore(Generic[WorldT]):
-    """The simulated station as a real-time node without a transport (see the module docstring).
+    """The simulated station as a real-time node without a protocol or transport (see the module docstring).
 
-    A binding sets :attr:`TOPIC_LOG` (the log-line prefix of each kind of message), may override
-    :meth:`_command` (how a command message becomes a :meth:`Controller.submit
-    <ur3hanoi.interface.controller.Controller.submit>`), :meth:`_emit` (where log lines go) and
-    :meth:`_report_transport` (its report section), and calls :meth:`loop` with its receive and publish steps
-    inside :meth:`signals` and :meth:`rendering` (then :meth:`close_sink` before the final report).
+    A protocol's core provides :meth:`_build_world`, :meth:`_command`, :meth:`_dropped`, :meth:`_step`,
+    :meth:`_report_motion` and :meth:`_report_final` (and may add kinds of message in :meth:`_handle`). A binding
+    sets :attr:`TOPIC_LOG` (the log-line prefix of each kind of message), may override :meth:`_command`,
+    :meth:`_emit` (where log lines go) and :meth:`_report_transport` (its report section), and calls :meth:`loop`
+    with its receive and publish steps inside :meth:`signals` and :meth:`rendering` (then :meth:`close_sink` before
+    the final report).
 
     Args:
         options: what to run.
@@ -140,7 +144,7 @@ class ServerCore(Generic[WorldT]):
 
     def __init__(self, options: ServerOptions, out: Callable[[str], None],
                  report_out: Callable[[str], None]) -> None:
-        from ur3hanoi.interface.lograte import RateLimitedLog
+        from ur3hanoi.interface.common.lograte import RateLimitedLog
         from ur3hanoi.sim.config import SimConfig
         from ur3hanoi.station.calibration import load_station, with_suction_profile
 
@@ -160,14 +164,8 @@ class ServerCore(Generic[WorldT]):
         self.frames = FrameOutput(opts.calibration, n_blocks, opts.frames, opts.video)
 
     def _build_world(self, config: SimConfig, n_blocks: int) -> WorldT:
-        """The simulated station and what drives it: the course's ``movej`` controller (a subclass: another)."""
-        from ur3hanoi.interface.controller import Controller
-        from ur3hanoi.sim.world import MoveJWorld
-
-        opts = self.options
-        world = MoveJWorld(self.station, opts.start, n_blocks, opts.removed, config, opts.drop_on_grasp)
-        self.controller = Controller(world)
-        return world  # type: ignore[return-value]  # the course's world; a subclass builds its own
+        """The simulated station and what drives it (the protocol's core: its world and controller)."""
+        raise NotImplementedError
 
     # ---------------------------------------------------------------------------------------------- callbacks
     def on_command(self, msg: Any) -> None:
@@ -184,12 +182,12 @@ class ServerCore(Generic[WorldT]):
         self.inbox.offer("remove", block)
 
     def _emit(self, level: str, text: str) -> None:
-        """Write one log line (``level`` of :data:`ur3hanoi.interface.lograte.LEVELS`)."""
+        """Write one log line (``level`` of :data:`ur3hanoi.interface.common.lograte.LEVELS`)."""
         self.out(text)
 
     def _command(self, msg: Any) -> None:
-        """Queue one command message or raise :class:`CommandError` (recorded by the driver)."""
-        self.controller.submit(msg.destination, msg.v, msg.a, msg.io_0)
+        """Queue one command message or raise :class:`CommandError` (recorded by the protocol's controller)."""
+        raise NotImplementedError
 
     def submit_command(self, msg: Any) -> bool:
         """Check and queue one command now (True), or log why it is refused (False)."""
@@ -214,9 +212,8 @@ class ServerCore(Generic[WorldT]):
         self.log.flush()
 
     def _dropped(self, kind: str, reason: str) -> None:
-        """A message of ``kind`` the full inbox refused (recorded by a subclass's controller)."""
-        if kind == "command":
-            self.controller.refuse(reason)
+        """A message of ``kind`` the full inbox refused (recorded by the protocol's controller)."""
+        raise NotImplementedError
 
     def _handle(self, kind: str, payload: Any) -> None:
         """One message from the inbox: a command, a spawn or a removal (a subclass adds its own kinds)."""
@@ -246,8 +243,8 @@ class ServerCore(Generic[WorldT]):
         self._step()
 
     def _step(self) -> None:
-        """One driver and world step (the course's controller; a subclass: its own)."""
-        self.controller.cycle()
+        """One driver and world step (the protocol's controller)."""
+        raise NotImplementedError
 
     # ------------------------------------------------------------------------------------------------ report
     def _report_transport(self) -> dict[str, Any]:
@@ -255,14 +252,12 @@ class ServerCore(Generic[WorldT]):
         return {}
 
     def _report_motion(self) -> dict[str, Any]:
-        """The report's sections on what was commanded: the course controller's commands (a subclass: its own)."""
-        return {"commands": self.controller.summary(),
-                "executed": [m.as_dict() for m in self.controller.executed],
-                "rejected": [r.as_dict() for r in self.controller.rejected]}
+        """The report's sections on what was commanded (the protocol's controller's records)."""
+        raise NotImplementedError
 
     def _report_final(self) -> dict[str, Any]:
-        """The controller's part of the report's ``final`` section."""
-        return {"ready": self.controller.ready}
+        """The protocol's controller's part of the report's ``final`` section."""
+        raise NotImplementedError
 
     def report(self) -> dict[str, Any]:
         """The JSON report (see the module docstring); numbering from 1."""

@@ -26,8 +26,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from ur3hanoi.interface.command import MoveCommand, parse_command
-from ur3hanoi.interface.errors import CommandError
+from ur3hanoi.interface.common.errors import CommandError
+from ur3hanoi.interface.course.command import MoveCommand, parse_command
 from ur3hanoi.robot.movej import plan_movej
 from ur3hanoi.sim.world import MoveJWorld
 

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from ur3hanoi.interface.controller import Controller
-from ur3hanoi.interface.errors import CommandError
+from ur3hanoi.interface.common.errors import CommandError
+from ur3hanoi.interface.course.controller import Controller
 from ur3hanoi.sim.world import MoveJWorld
 from ur3hanoi.tables.ik_table import generate_table
 
