@@ -122,6 +122,13 @@ class DriverError(Ur3HanoiError):
     (``ur3hanoi.interface.ros1.errors.RosError``, ``ur3hanoi.interface.ros2.errors.DdsError``)."""
 
 
+class ProgramStoppedError(DriverError):
+    """The robot's External Control program stopped during a solve (the pendant's stop button, a protective stop):
+    the driver stopped its trajectory controller with it, the arm stopped where it was. Exit 3, as a halt."""
+
+    exit_code = 3
+
+
 class IKError(Ur3HanoiError):
     """Inverse kinematics failed: the pose is unreachable, out of joint limits, or off the home branch."""
 

@@ -299,10 +299,14 @@ def test_paths_with_control_characters_keep_the_header_a_comment(tmp_path: Path,
 
 
 def test_library_errors_map_to_exit_codes() -> None:
+    from ur3hanoi.errors import DriverError, ProgramStoppedError
+
     assert exit_code_for(SuctionFaultError("halted")) == 3
+    assert exit_code_for(ProgramStoppedError("the robot program stopped")) == 3
+    assert exit_code_for(DriverError("x")) == 2
     assert exit_code_for(PlanError("x")) == 2
     assert exit_code_for(Ur3HanoiError("x")) == 2
-    assert [code for _, code in EXIT_CODES] == [3, 2]
+    assert [code for _, code in EXIT_CODES] == [3, 3, 2]
 
 
 def _raise(exc: BaseException) -> object:

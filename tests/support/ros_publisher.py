@@ -3,7 +3,8 @@
 Usage:
 
 - ``python tests/support/ros_publisher.py JSON`` with JSON a list of ``[topic, type, fields]``, type one of ``command``
-  (ur3_driver/command), ``Int32`` (std_msgs/Int32) or ``String`` (std_msgs/String, a wrong type for
+  (ur3_driver/command), ``Int32`` (std_msgs/Int32), ``Bool`` (std_msgs/Bool) or ``String`` (std_msgs/String, a
+  wrong type for
   /ur3/command). Waits for a subscriber on every topic first (rospy drops messages published before that), sends
   the messages in order 50 ms apart and lets them drain before exiting.
 - ``python tests/support/ros_publisher.py --flood HZ SECONDS JSON_FIELDS``: publish the ``command`` JSON_FIELDS (a list
@@ -71,7 +72,7 @@ def main() -> int:
         return flood(float(sys.argv[2]), float(sys.argv[3]), json.loads(sys.argv[4]))
     items = json.loads(sys.argv[1])
     rospy, std_msgs, msgs = import_rospy(), import_std_msgs(), load_messages()
-    types = {"command": msgs.command, "Int32": std_msgs.Int32, "String": std_msgs.String}
+    types = {"command": msgs.command, "Int32": std_msgs.Int32, "String": std_msgs.String, "Bool": std_msgs.Bool}
     rospy.init_node("ur3hanoi_test_publisher", anonymous=True, argv=[sys.argv[0]], disable_signals=True)
     pubs = {}
     for topic, kind, _fields in items:

@@ -14,6 +14,8 @@ every check of that client passed, 1 otherwise:
   positions, velocities and accelerations, the first the current state.
 - ``bridge``: a course bridge in the style of ECE470's (``movej`` per waypoint) mapped onto the action: one goal per
   waypoint, a single point whose time is the ``movej``'s duration, waiting for each result.
+- ``program``: the External Control program stopped mid-goal and started again: the goal preempted, the latched
+  ``robot_program_running``, a goal rejected meanwhile (INVALID_GOAL, no error string), one after it runs again.
 - ``set-io``: ``set_io`` called with the current Noetic ``ur_msgs/SetIO`` text, with ur_msgs 1.3.x's, and with
   ``md5sum *``; each must switch the output seen in ``io_states``.
 """
@@ -163,8 +165,54 @@ def set_io_versions() -> dict[str, Any]:
     return {"ok": all(seen.values()), **seen}
 
 
+def program() -> dict[str, Any]:
+    """The External Control program stopped mid-goal (ur3hanoi's fault topic, as the pendant's stop button) and
+    started again, seen through actionlib and the driver's latched ``robot_program_running``."""
+    rospy, m, client = connect()
+    import sensor_msgs.msg
+    import std_msgs.msg
+    from actionlib_msgs.msg import GoalStatus
+
+    def running() -> bool:  # a fresh subscription: the latched value
+        return bool(rospy.wait_for_message(ROS1.program_running, std_msgs.msg.Bool, timeout=5.0).data)
+
+    fault = rospy.Publisher("/ur3hanoi/program_running", std_msgs.msg.Bool, queue_size=1)
+    end = rospy.get_time() + 5.0
+    while fault.get_num_connections() == 0 and rospy.get_time() < end:
+        rospy.sleep(0.05)
+    js = rospy.wait_for_message(ROS1.joint_states, sensor_msgs.msg.JointState)
+    q0 = [js.position[js.name.index(j)] for j in CONTROLLER_JOINTS]
+
+    def goal(dq: float, t: float) -> Any:
+        g = m.FollowJointTrajectoryGoal()
+        g.trajectory.joint_names = list(CONTROLLER_JOINTS)
+        g.trajectory.points = [point(m, rospy, [*q0[:5], q0[5] + dq], t, [0.0] * 6)]
+        return g
+
+    seen: dict[str, Any] = {"at_start": running()}
+    client.send_goal(goal(0.4, 3.0))
+    rospy.sleep(0.5)
+    fault.publish(std_msgs.msg.Bool(False))
+    client.wait_for_result(rospy.Duration(10))
+    seen["stopped_goal"] = client.get_state()
+    seen["after_stop"] = running()
+    client.send_goal(goal(0.2, 1.0))
+    client.wait_for_result(rospy.Duration(10))
+    result = client.get_result()
+    seen["while_stopped"] = [client.get_state(), int(result.error_code), str(result.error_string)]
+    fault.publish(std_msgs.msg.Bool(True))
+    rospy.sleep(0.2)
+    seen["after_resume"] = running()
+    seen["resumed"] = send(client, goal(0.0, 1.5))
+    seen["ok"] = (seen["at_start"] and seen["stopped_goal"] == GoalStatus.PREEMPTED and not seen["after_stop"]
+                  and seen["while_stopped"] == [GoalStatus.REJECTED, -1, ""] and seen["after_resume"]
+                  and seen["resumed"][0] == 0)
+    return seen
+
+
 if __name__ == "__main__":
-    run = {"integration": integration, "moveit": moveit, "bridge": bridge, "set-io": set_io_versions}[sys.argv[1]]
+    run = {"integration": integration, "moveit": moveit, "bridge": bridge, "set-io": set_io_versions,
+           "program": program}[sys.argv[1]]
     out = run()
     print(json.dumps(out))
     sys.exit(0 if out["ok"] else 1)

@@ -11,7 +11,8 @@ test_trajectory_scaled_aborts_on_violation, test_set_io). Changes: positions are
 (the originals drive every joint to 0, -0.5, -1 rad, into the table of a Tower of Hanoi cell) and times are shorter;
 the checks the originals assert are collected into one JSON line instead of unittest; the controller-manager and
 dashboard calls are left out (the station has neither). Added: a goal preempted by another, a cancel, the speed
-scaling topic, a last point that still moves.
+scaling topic, a last point that still moves, the External Control program stopped mid-goal and started again
+(``robot_program_running``, ur3hanoi's fault topic), a single point at t = 0.
 
 Usage: ur_driver_examples.py HOME_JSON ACTION_NAME
 """
@@ -25,8 +26,9 @@ from builtin_interfaces.msg import Duration
 from control_msgs.action import FollowJointTrajectory
 from rclpy.action import ActionClient
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64
+from std_msgs.msg import Bool, Float64
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from ur_msgs.msg import IOStates
 from ur_msgs.srv import SetIO
@@ -124,6 +126,39 @@ class Robot:
         return time.monotonic() - t0
 
 
+def program(robot, node, offset, out):
+    """Added: the External Control program stops mid-goal (ur3hanoi's fault topic) and runs again; then a single
+    point at t = 0 where the arm is (accepted by the ROS 2 controller)."""
+    latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    topic = "/io_and_status_controller/robot_program_running"
+    state = {}
+    node.create_subscription(Bool, topic, lambda m: state.__setitem__("running", m.data), latched)
+    fault = node.create_publisher(Bool, "/ur3hanoi/program_running", 10)
+    robot.spin_until(lambda: "running" in state and fault.get_subscription_count() > 0, 5.0)
+    out["program_at_start"] = state.get("running")
+    slow = robot.send(robot.trajectory([offset(-0.4)], [4.0]))
+    robot.spin_until(lambda: False, 0.5)
+    fault.publish(Bool(data=False))
+    out["stopped_goal"] = robot.result(slow)
+    robot.spin_until(lambda: state.get("running") is False, 2.0)
+    out["program_after_stop"] = state.get("running")
+    late = {}
+    node.create_subscription(Bool, topic, lambda m: late.setdefault("running", m.data), latched)
+    robot.spin_until(lambda: "running" in late, 2.0)
+    out["late_subscriber"] = late.get("running")
+    out["accepted_while_stopped"] = robot.send(robot.trajectory([offset(-0.3)], [1.0])).accepted
+    robot.io = robot.joint_state = None
+    robot.spin_until(lambda: robot.io is not None and robot.joint_state is not None, 1.0)
+    out["states_while_stopped"] = robot.io is not None and robot.joint_state is not None
+    fault.publish(Bool(data=True))
+    robot.spin_until(lambda: state.get("running") is True, 2.0)
+    out["program_after_resume"] = state.get("running")
+    here = robot.position()
+    gh = robot.send(robot.trajectory([[here[j] + 0.02 for j in ROBOT_JOINTS]], [0.0]))
+    out["t0_point_accepted"] = gh.accepted
+    out["t0_point"] = robot.result(gh, 5.0) if gh.accepted else None
+
+
 def main():
     home = json.loads(sys.argv[1])
     rclpy.init()
@@ -201,6 +236,7 @@ def main():
     robot.spin_until(lambda: robot.io is not None, 1.0)
     out["do1_after_off"] = robot.io.digital_out_states[1].state
     out["set_flag"] = robot.set_io(2, 1, 1.0)
+    program(robot, node, offset, out)
     print(json.dumps(out), flush=True)
     node.destroy_node()
     rclpy.shutdown()

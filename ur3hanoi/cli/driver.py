@@ -15,7 +15,7 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from ur3hanoi.cli.options import DRIVER_WAIT, SPEED_SLIDER, option
+from ur3hanoi.cli.options import DRIVER_WAIT, SIM_TIME, SPEED_SLIDER, option
 
 if TYPE_CHECKING:
     from ur3hanoi.cli.remote import SolveJob
@@ -36,6 +36,13 @@ def add_driver_option(p: argparse.ArgumentParser, station: bool) -> None:
         p.add_argument("--speed-scaling", type=option(SPEED_SLIDER), default=1.0, metavar="F",
                        help="with --driver ur: the pendant's speed slider, a fraction in (0, 1] (default 1): the "
                             "trajectory controller's time runs this much slower")
+        p.add_argument("--program-stop-at", type=option(SIM_TIME), default=None, metavar="S",
+                       help="with --driver ur, fault injection: the External Control program stops S seconds after "
+                            "the station starts (0: stopped from the start), as the pendant's stop button does: "
+                            "robot_program_running turns false, the running goal ends, new goals are refused")
+        p.add_argument("--program-resume-at", type=option(SIM_TIME), default=None, metavar="S",
+                       help="with --driver ur and --program-stop-at: the program runs again S seconds after the "
+                            "station starts (the pendant's play button)")
     else:
         p.add_argument("--far-start", choices=("approach", "refuse"), default="approach",
                        help="with --driver ur, an arm far from where the plan starts: approach = move it there "
@@ -43,6 +50,20 @@ def add_driver_option(p: argparse.ArgumentParser, station: bool) -> None:
         p.add_argument("--wait", type=option(DRIVER_WAIT), default=15.0, metavar="S",
                        help="with --driver ur: wait at most S seconds for the driver's joint states, io_states, "
                             "action server and set_io (default 15)")
+
+
+def program_times(args: argparse.Namespace) -> tuple[float | None, float | None]:
+    """``--program-stop-at`` and ``--program-resume-at`` [s] (one line when they contradict)."""
+    from ur3hanoi.errors import InputError
+
+    stop, resume = args.program_stop_at, args.program_resume_at
+    if resume is not None and (stop is None or resume <= stop):
+        raise InputError(f"--program-resume-at {resume:g} needs an earlier --program-stop-at (got "
+                         f"{'none' if stop is None else f'{stop:g}'}): the program can only start again after it "
+                         "stopped")
+    if stop is not None and args.driver != "ur":
+        raise InputError("--program-stop-at needs --driver ur (the course's topics have no robot program)")
+    return stop, resume
 
 
 def driver_plan(args: argparse.Namespace, job: SolveJob, default_calibration: str) -> Plan:
@@ -60,12 +81,12 @@ def driver_plan(args: argparse.Namespace, job: SolveJob, default_calibration: st
 def run_driver_solve_command(args: argparse.Namespace, transport: Any, make_plan: Callable[[], Plan],
                              outcome: dict[str, object]) -> int:
     """Connect ``transport`` (no driver: an error at once, before planning), plan, run the plan, print the outcome
-    (one JSON object with ``--json``); a suction fault is re-raised (exit 3) after its outcome is printed; every
-    other error propagates (exit 2)."""
+    (one JSON object with ``--json``); a suction fault or a stopped robot program is re-raised (exit 3) after its
+    outcome is printed; every other error propagates (exit 2)."""
     import json
 
     from ur3hanoi.cli.remote import say_for
-    from ur3hanoi.errors import SuctionFaultError
+    from ur3hanoi.errors import ProgramStoppedError, SuctionFaultError
     from ur3hanoi.interface.urdriver.solve import DriverSolveConfig, run_driver_solve
 
     say = say_for(args)
@@ -77,7 +98,7 @@ def run_driver_solve_command(args: argparse.Namespace, transport: Any, make_plan
         say(f"connected to the UR driver on {transport.where}: {len(plan.moves)} moves, plan {plan.duration_s:.1f} s")
         try:
             result = run_driver_solve(transport, plan, plan.station.wiring, config, log=say)
-        except SuctionFaultError as exc:
+        except (SuctionFaultError, ProgramStoppedError) as exc:
             outcome.update(status="halted", exit_code=exc.exit_code, error=str(exc))
             if args.json:
                 print(json.dumps(outcome))

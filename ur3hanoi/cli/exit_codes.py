@@ -4,7 +4,7 @@
 0     success
 1     ``check-table``: some entry is over the tolerance
 2     bad input: an invalid file, option or output path, an unreachable pose, a failed plan check
-3     suction fault in ``solve`` (halted: suction off, arm at home)
+3     halted: a suction fault in a solve (suction off, arm at home), or the robot program stopped in one
 70    internal error (a bug: rerun with ``--debug`` for the traceback)
 130   interrupted (Ctrl-C)
 143   terminated (SIGTERM: the same clean-up as a Ctrl-C)
@@ -14,7 +14,7 @@
 
 from __future__ import annotations
 
-from ur3hanoi.errors import SuctionFaultError, Ur3HanoiError
+from ur3hanoi.errors import ProgramStoppedError, SuctionFaultError, Ur3HanoiError
 
 OK = 0
 OVER_TOLERANCE = 1
@@ -27,6 +27,7 @@ BROKEN_PIPE = 141
 
 EXIT_CODES: tuple[tuple[type[Ur3HanoiError], int], ...] = (
     (SuctionFaultError, SUCTION_FAULT),
+    (ProgramStoppedError, SUCTION_FAULT),
     (Ur3HanoiError, BAD_INPUT),
 )
 """Library exception classes and their exit codes, most specific first."""

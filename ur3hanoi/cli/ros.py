@@ -76,8 +76,10 @@ def _node(args: argparse.Namespace, report_file: Path | None) -> RosStation:
     if args.driver == "ur":
         from ur3hanoi.interface.ros1.ur_server import RosDriverOptions, RosDriverServer
 
+        stop, resume = driver.program_times(args)
         return RosDriverServer(RosDriverOptions(**fields, master_uri=args.master, host=args.host,
-                                                speed_scaling=args.speed_scaling))
+                                                speed_scaling=args.speed_scaling, program_stop_at_s=stop,
+                                                program_resume_at_s=resume))
     return RosServer(RosServerOptions(**fields, master_uri=args.master, host=args.host))
 
 

@@ -101,9 +101,11 @@ def _run_station(args: argparse.Namespace) -> int:
 
         import_rclpy()  # say what is missing before loading the world
 
+        stop, resume = driver.program_times(args)
         report = Ros2DriverStation(Ros2DriverOptions(**fields, speed_scaling=args.speed_scaling,
                                                      distro=_distro(args), network=args.network,
-                                                     domain_id=args.domain_id)).run()
+                                                     domain_id=args.domain_id, program_stop_at_s=stop,
+                                                     program_resume_at_s=resume)).run()
     else:
         from ur3hanoi.interface.ros2.server import Ros2Server, Ros2ServerOptions
 

@@ -30,7 +30,16 @@ def test_a_solve_then_a_dropped_block_halt_through_the_ur_driver_interface(tmp_p
         mid = st.snapshot()
         halted = run(ur3hanoi_cmd("ros-solve", "--driver", "ur", "--start", "3", "--end", "1", "--blocks", "1"), env,
                      120.0)
+        stop = [["/ur3hanoi/program_running", "Bool", {"data": False}]]  # the pendant's stop button
+        assert run([sys.executable, str(SUPPORT / "ros_publisher.py"), json.dumps(stop)], env, 60.0).returncode == 0
+        sent = st.snapshot()["goals"]["received"]
+        refused = solve(env, "--blocks", "1")
         report = st.stop()
+    assert refused.returncode == 2, refused.stdout + refused.stderr
+    assert [line for line in refused.stderr.splitlines() if line.startswith("ur3hanoi: error")] == [
+        "ur3hanoi: error: the robot program is not running (robot_program_running is false on "
+        f"{env['ROS_MASTER_URI']}): the driver's trajectory controller refuses every goal until it runs; start the "
+        "External Control program on the pendant"]
     assert solved.returncode == 0, solved.stdout + solved.stderr
     outcome = json.loads(solved.stdout.strip().splitlines()[-1])
     assert outcome["status"] == "solved" and outcome["moves"] == 1 and outcome["goals"] == 3
@@ -41,6 +50,7 @@ def test_a_solve_then_a_dropped_block_halt_through_the_ur_driver_interface(tmp_p
     errors = [line for line in halted.stderr.splitlines() if line.startswith("ur3hanoi: error")]
     assert len(errors) == 1 and "green block 1 was dropped while carrying it from tower 3 to tower 1" in errors[0]
     assert len(report["halts"]) == 1 and report["halts"][0]["cycles"] >= 1 and report["goals"]["canceled"] == 1
+    assert report["goals"]["received"] == sent and [e["running"] for e in report["program"]] == [False]  # refused
     assert report["final"]["at_home"] and not report["final"]["suction_on"]
 
 

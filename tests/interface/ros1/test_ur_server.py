@@ -58,3 +58,11 @@ def test_the_ur_drivers_own_integration_test_client(driver_station):
     late = [g for g in report["goal_records"] if g.get("result") == "GOAL_TOLERANCE_VIOLATED (-5)"]
     assert late and late[-1]["lateness_s"] > 0.0
     assert report["driver"]["profile"] == "ros1_scaled" and report["control"]["rate_hz"] == 125.0
+
+
+def test_a_stopped_program_preempts_the_goal_and_rejects_new_ones_without_a_text(driver_station):
+    st, env = driver_station
+    out = client(env, "program")
+    assert out["ok"], out
+    assert out["while_stopped"] == [5, -1, ""]  # REJECTED, INVALID_GOAL, no error string (goalCB)
+    assert [e["running"] for e in st.snapshot()["program"]] == [False, True]

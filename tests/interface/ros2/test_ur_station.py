@@ -58,22 +58,25 @@ def _json(path: Path) -> dict[str, Any]:
 
 
 @pytest.fixture(scope="module")
-def jazzy_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
-    """One station (Jazzy, slider at 50 %) and two clients: the driver's examples, then a MoveIt-style goal."""
+def jazzy_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], ...]:
+    """One station (Jazzy, slider at 50 %) and three clients: the driver's examples and integration tests
+    (ported), UR's own example client (unmodified, tests/support/ur_examples_runner.py), a MoveIt-style goal."""
     env, tmp = build_env("jazzy"), tmp_path_factory.mktemp("ur-jazzy")
     action = names_for("jazzy").follow_joint_trajectory
     home = json.dumps(HOME)
     script = _script(env, tmp, "--blocks 1 --speed-scaling 0.5",
                      env.peer_command(str(SUPPORT / "ur_driver_examples.py"), home, action),
-                     env.peer_command(str(SUPPORT / "moveit_style_client.py"), home, action, "2.0"))
+                     env.peer_command(str(SUPPORT / "moveit_style_client.py"), home, action, "2.0"),
+                     env.peer_command(str(SUPPORT / "ur_examples_runner.py"), home))
     result = in_netns(script, 240.0, REPO)
     assert result.returncode == 0, result.stderr + _errors(tmp)
     assert "station exit 0" in result.stderr
-    return _json(tmp / "peer0.json"), _json(tmp / "peer1.json"), json.loads((tmp / "report.json").read_text())
+    return (_json(tmp / "peer0.json"), _json(tmp / "peer1.json"), json.loads((tmp / "report.json").read_text()),
+            _json(tmp / "peer2.json"))
 
 
 def test_topics_names_order_and_units(jazzy_run: tuple[dict[str, Any], ...]) -> None:
-    examples, _, report = jazzy_run
+    examples, _, report, _ = jazzy_run
     assert sorted(examples["joint_names"]) == sorted(JOINTS) and examples["joint_names"] != JOINTS  # not by index
     assert examples["start_error"] < 1e-3
     assert examples["speed_scaling"] == pytest.approx(50.0, abs=1e-6)  # percent, as the ROS 2 driver publishes
@@ -89,10 +92,10 @@ def test_the_drivers_example_trajectory_succeeds_slowed_by_the_slider(jazzy_run:
 
 
 def test_invalid_goals_are_rejected_at_send_goal(jazzy_run: tuple[dict[str, Any], ...]) -> None:
-    examples, _, report = jazzy_run
+    examples, _, report, _ = jazzy_run
     assert not examples["illegal_accepted"] and not examples["moving_end_accepted"]
     assert not examples["bad_joints_accepted"]
-    assert report["transport"]["rejected_at_send_goal"] == 3
+    assert report["transport"]["rejected_at_send_goal"] == 6  # and 3 to stopped or inactive controllers
 
 
 def test_preempt_cancel_and_path_abort(jazzy_run: tuple[dict[str, Any], ...]) -> None:
@@ -105,6 +108,19 @@ def test_preempt_cancel_and_path_abort(jazzy_run: tuple[dict[str, Any], ...]) ->
     assert examples["violation"] == {"status": "ABORTED", "error_code": -4,
                                      "error_string": "Aborted due to path tolerance violation"}, examples
     assert examples["stop_after_abort_s"] < 1.5 and examples["drift_after_abort"] < 5e-3, examples  # stops, holds
+
+
+def test_a_stopped_program_ends_the_goal_and_refuses_new_ones_and_the_state_is_latched(
+        jazzy_run: tuple[dict[str, Any], ...]) -> None:
+    examples, _, report, _ = jazzy_run
+    assert examples["program_at_start"] is True and examples["program_after_stop"] is False, examples
+    assert examples["stopped_goal"] == {"status": "ABORTED", "error_code": -1, "error_string":
+                                        "Current goal cancelled during deactivate transition."}, examples
+    assert examples["late_subscriber"] is False  # transient local: a client that connects later hears it too
+    assert not examples["accepted_while_stopped"] and examples["states_while_stopped"]
+    assert examples["program_after_resume"] is True
+    assert examples["t0_point_accepted"] and examples["t0_point"]["status"] == "SUCCEEDED", examples
+    assert [e["running"] for e in report["program"]] == [False, True] * 2  # the fault topic, then the dashboard
 
 
 def test_set_io_returns_once_the_output_changed(jazzy_run: tuple[dict[str, Any], ...]) -> None:
@@ -147,3 +163,27 @@ def test_enme480_bridge_on_the_driver_interface_solves_one_block(tmp_path: Path)
 
 if __name__ == "__main__":
     sys.exit(pytest.main([__file__, "-q"]))
+
+
+def test_urs_own_example_client_runs_unmodified_with_the_controller_manager_and_dashboard(
+        jazzy_run: tuple[dict[str, Any], ...]) -> None:
+    ur = jazzy_run[3]
+    assert ur["connected"] and ur["set_io"], ur
+    assert ur["controllers"]["scaled_joint_trajectory_controller"] == "active"
+    assert ur["controllers"]["passthrough_trajectory_controller"] == "inactive"
+    assert ur["play"] == [True, "Starting program"] and ur["trajectory"] is True, ur
+    assert ur["to_passthrough"] == [True, ""] and ur["scaled_while_passthrough"] == "trajectory was not accepted"
+    assert ur["both_position"][0] is False and "Resource conflict" in ur["both_position"][1], ur
+    assert ur["back"] == [True, ""]
+    assert ur["again"] == [False, "Could not activate controller 'scaled_joint_trajectory_controller' since it is "
+                                  "already active"]
+    assert ur["unknown"] == [False, "Could not activate controller with name 'no_such_controller' because no "
+                                    "controller with this name exists"]
+    assert ur["stop"] == [True, "Stopped"] and ur["running_after_stop"] == [True, "Program running: false", False]
+    assert ur["controllers_after_stop"]["scaled_joint_trajectory_controller"] == "inactive"
+    assert ur["controllers_after_stop"]["io_and_status_controller"] == "active"  # a consistent controller
+    assert ur["trajectory_while_stopped"] == "trajectory was not accepted"
+    assert ur["stop_again"] == [False, "Failed to execute: Stop"]
+    assert ur["play_again"] == [True, "Starting program"] and ur["running_after_play"][2] is True
+    assert ur["controllers_after_play"]["scaled_joint_trajectory_controller"] == "active"
+    assert ur["trajectory_after_play"] is True, ur

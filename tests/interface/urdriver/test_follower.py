@@ -193,8 +193,64 @@ def test_an_empty_trajectory_stops_and_succeeds():
     assert [o.status for _, o in outcomes] == ["succeeded"]
 
 
-def test_a_stopped_controller_refuses_goals():
-    f = follower()
-    f.running = False
-    r = f.submit("a", goal(Q0 + 0.5, 1.0))
-    assert r is not None and r.code == ErrorCode.INVALID_GOAL and "not running" in r.error_string
+def test_a_stopped_program_ends_the_goal_as_each_driver_does_and_refuses_goals_without_a_text():
+    for profile, status, text in ((ROS1_SCALED, "preempted", ""),
+                                  (ROS2_SCALED, "aborted", "Current goal cancelled during deactivate transition.")):
+        f = follower(profile)
+        f.submit("a", goal(Q0 + 1.0, 2.0))
+        _, qs = run(f, 100, actual=lagging(0.05))
+        measured = qs[-2] - 0.05  # what the last cycle read
+        f.set_running(False)
+        (o,) = f.take_outcomes()
+        assert (o.status, o.error_string) == (status, text)
+        assert o.code == (ErrorCode.INVALID_GOAL if text else ErrorCode.SUCCESSFUL)
+        r = f.submit("b", goal(Q0 + 0.5, 1.0))
+        assert r is not None and (r.code, r.error_string) == (ErrorCode.INVALID_GOAL, "")  # ROS 1: no error string
+        assert r.reason == "Can't accept new action goals. Controller is not running."
+        _, qs = run(f, 20, actual=lambda k, d, m=measured: m)
+        np.testing.assert_allclose(qs[-1], measured, atol=1e-12)  # the arm stopped where it was
+        f.set_running(True)
+        assert f.submit("c", goal(Q0, 1.0, q_start=measured)) is None
+
+
+def test_ros2_holds_the_measured_position_after_an_abort_not_the_desired_one():
+    f = follower(ROS2_SCALED)
+    f.submit("a", goal(Q0 + 1.0, 2.0))
+    stuck = Q0 + 0.1  # the arm stops 0.1 rad along: the desired position runs 0.2 rad past it
+    (_, o), = run(f, 300, actual=lambda k, d: np.minimum(d.q, stuck))[0]
+    assert o.code == ErrorCode.PATH_TOLERANCE_VIOLATED
+    np.testing.assert_allclose(f.desired.q, stuck, atol=1e-12)
+    g = follower(ROS1_SCALED)  # ROS 1 keeps following its trajectory: the contrast
+    g.submit("a", goal(Q0 + 1.0, 2.0))
+    run(g, 300, actual=lambda k, d: np.minimum(d.q, stuck))
+    assert np.max(np.abs(g.desired.q - stuck)) > 0.5
+
+
+def test_ros2_starts_a_new_goal_from_the_measured_state_ros1_from_the_desired_one():
+    for profile, from_measured in ((ROS2_SCALED, True), (ROS1_SCALED, False)):
+        f = follower(profile)
+        f.submit("a", goal(Q0 + 1.0, 2.0))
+        run(f, 100)
+        desired = f.desired.q.copy()
+        measured = desired - 0.05  # the arm lags 0.05 rad behind
+        f.submit("b", TrajectoryGoal(CONTROLLER_JOINTS, (TrajectoryPoint(tuple(Q0), Z, Z, time_from_start_s=2.0),)))
+        first = f.update(measured, np.zeros(6), DT, 1.0).q
+        start = measured if from_measured else desired
+        assert np.max(np.abs(first - start)) < 0.01  # one cycle along the bridge from there
+        assert np.max(np.abs(first - (desired if from_measured else measured))) > 0.04
+
+
+def test_a_single_point_at_zero_seconds_ros2_commands_it_ros1_drops_it():
+    near = Q0 + 0.05
+    one = TrajectoryGoal(CONTROLLER_JOINTS, (TrajectoryPoint(tuple(near), time_from_start_s=0.0),))
+    f = follower(ROS2_SCALED)
+    assert f.submit("a", one) is None
+    outcomes, qs = run(f, 10)
+    np.testing.assert_allclose(qs[0], near, atol=1e-12)  # commanded at once
+    assert [o.status for _, o in outcomes] == ["succeeded"]
+    f = follower(ROS2_SCALED)  # farther than the path tolerance: aborted on its first sample
+    f.submit("a", TrajectoryGoal(CONTROLLER_JOINTS, (TrajectoryPoint(tuple(Q0 + 0.3), time_from_start_s=0.0),)))
+    (_, o), = run(f, 3, actual=lambda k, d: Q0.copy())[0]
+    assert o.code == ErrorCode.PATH_TOLERANCE_VIOLATED
+    r = follower(ROS1_SCALED).submit("a", one)
+    assert r is not None and r.error_string.startswith("Dropping all 1 trajectory point(s)")

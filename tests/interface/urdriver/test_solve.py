@@ -180,3 +180,32 @@ def test_a_hand_recorded_tables_plan_runs_too():
     tr.connect()
     result = run_driver_solve(tr, p, st.station.wiring)
     assert slots(st) == {1: (3, 1)} and result.executed_s == pytest.approx(p.duration_s, rel=0.02)
+
+
+def test_a_stopped_robot_program_refuses_the_solve_before_any_goal():
+    with pytest.raises(DriverError, match=r"^the robot program is not running \(robot_program_running is false on "
+                                          r"the loopback station\): .*; start the External Control program on the "
+                                          r"pendant$") as err:
+        solve(1, program_stop_at_s=0.0)
+    assert err.value.station.report()["goals"]["received"] == 0  # type: ignore[attr-defined]
+
+
+def test_a_program_stopped_mid_solve_ends_it_exit_3_suction_off_the_arm_where_it_was():
+    from ur3hanoi.errors import ProgramStoppedError
+    from ur3hanoi.interface.urdriver.profile import ROS1_SCALED, ROS2_SCALED
+
+    p = plan(1)
+    carry = p.duration_s / 2  # in the carry of the one block: the suction is on
+    for profile, how in ((ROS1_SCALED, r"preempted \(.*\)"),
+                         (ROS2_SCALED, r'aborted: INVALID_GOAL \(-1\) "Current goal cancelled during deactivate '
+                                       r'transition\."')):
+        with pytest.raises(ProgramStoppedError, match=r"^the External Control program stopped on the robot during "
+                                                      r"goal \d/3 \(\w+ of move 1\) \(robot_program_running false; "
+                                                      rf"the controller: {how}\): the arm stopped where it was, "
+                                                      r"suction off; .*run again$") as err:
+            solve(1, program_stop_at_s=carry, profile=profile)
+        st = err.value.station  # type: ignore[attr-defined]
+        st.cycle()  # the set_io queued last takes effect in the next control cycle
+        assert err.value.exit_code == 3 and not st.world.suction_on
+        assert st.world.time == pytest.approx(carry, abs=0.6)  # ended at the stop, not after a timeout
+        assert not st.report()["final"]["at_home"] and st.report()["goals"]["received"] == 2

@@ -4,6 +4,8 @@ report."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -172,8 +174,22 @@ def test_a_stopped_robot_program_preempts_the_goal_and_refuses_new_ones(home):
     tr.wait(0.0)
     assert h.done() and h.result().status == "preempted"
     r, _ = send(tr, goal(home, 1.0, st.world.q))
-    assert (r.status, r.code, r.error_string) == ("rejected", ErrorCode.INVALID_GOAL,
-                                                  "Can't accept new commands. Controller is not running.")
+    assert (r.status, r.code, r.error_string) == ("rejected", ErrorCode.INVALID_GOAL, "")  # goalCB: no text
     st.on_program(True)
     assert send(tr, goal(home, 1.0, st.world.q))[0].status == "succeeded"
     assert st.report()["final"]["program_running"]
+
+
+def test_the_program_stops_and_runs_again_at_the_times_given_and_the_states_go_on(home):
+    st, tr = fresh(program_stop_at_s=0.1, program_resume_at_s=0.3)
+    seen = []
+    for _ in range(60):  # 0.48 s at 125 Hz
+        tr.wait(0.0)
+        seen.append((st.output.t_s, st.output.program_running))
+    stopped = [t for t, running in seen if not running]
+    again = next(t for t, running in seen if running and t > stopped[0])
+    assert 0.1 <= stopped[0] <= 0.1 + 2 * 0.008 and 0.3 <= again <= 0.3 + 2 * 0.008  # within its control cycle
+    assert all(b[0] > a[0] for a, b in itertools.pairwise(seen))  # joint states and io_states go on
+    assert [e["running"] for e in st.report()["program"]] == [False, True]
+    st, tr = fresh(program_stop_at_s=0.0)  # stopped from the start: the first output says so
+    assert not st.output.program_running

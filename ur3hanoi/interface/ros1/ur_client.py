@@ -86,7 +86,7 @@ class RosDriverTransport:
         with self._wake:
             s = self._state
             self._state = DriverState(**{"q": s.q, "t_q": s.t_q, "io": s.io, "speed_scaling": s.speed_scaling,
-                                         **fields})
+                                         "program_running": s.program_running, **fields})
             self._wake.notify_all()
 
     def _on_joint_states(self, msg: Any) -> None:
@@ -138,6 +138,8 @@ class RosDriverTransport:
         rospy.Subscriber(ROS1.joint_states, sensor_msgs.JointState, self._on_joint_states, tcp_nodelay=True)
         rospy.Subscriber(ROS1.io_states, m.IOStates, self._on_io_states, tcp_nodelay=True)
         rospy.Subscriber(ROS1.speed_scaling, std_msgs.Float64, self._on_speed_scaling, tcp_nodelay=True)
+        rospy.Subscriber(ROS1.program_running, std_msgs.Bool, lambda msg: self._update(program_running=bool(msg.data)),
+                         tcp_nodelay=True)
         self._client = actionlib.SimpleActionClient(ROS1.follow_joint_trajectory, m.FollowJointTrajectoryAction)
         self._set_io = rospy.ServiceProxy(ROS1.set_io, m.SetIO, headers={"md5sum": "*"})
         deadline = time.monotonic() + self.connect_timeout_s

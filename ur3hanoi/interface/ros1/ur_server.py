@@ -18,7 +18,9 @@ and order are the driver's (:data:`ur3hanoi.interface.urdriver.facts.ROS1`):
 - ``/ur_hardware_interface/robot_program_running`` (``std_msgs/Bool``, latched);
 - fault injection: ``/ur3hanoi/hold_arm`` (``std_msgs/Float64``: seconds the arm is held where it is) and
   ``/ur3hanoi/program_running`` (``std_msgs/Bool``: false stops the robot program, as on the pendant: the running
-  goal is preempted, new goals get INVALID_GOAL until it runs again).
+  goal is preempted (``JointTrajectoryController::stopping``), new goals are rejected with INVALID_GOAL and no
+  ``error_string`` (``goalCB``, ros_controllers noetic-devel ``joint_trajectory_controller_impl.h``) until it runs
+  again); the same at the times of ``--program-stop-at`` / ``--program-resume-at``.
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ HOLD_TOPIC = "/ur3hanoi/hold_arm"
 """Fault injection: ``std_msgs/Float64`` seconds the arm is held (a person or an obstacle in the way)."""
 PROGRAM_TOPIC = "/ur3hanoi/program_running"
 """Fault injection: ``std_msgs/Bool`` false = the robot program stopped on the pendant (the controller stops)."""
-PROGRAM_RUNNING = "/ur_hardware_interface/robot_program_running"
+PROGRAM_RUNNING = ROS1.program_running
 """The driver's latched ``std_msgs/Bool``: whether the robot program runs."""
 
 
@@ -140,8 +142,8 @@ class RosDriverServer(RosStation, DriverStation):
         rospy.Subscriber(HOLD_TOPIC, std_msgs.Float64, lambda msg: self.on_hold(msg.data), queue_size=10)
         rospy.Subscriber(PROGRAM_TOPIC, std_msgs.Bool, lambda msg: self.on_program(msg.data), queue_size=10)
         program = rospy.Publisher(PROGRAM_RUNNING, std_msgs.Bool, queue_size=1, latch=True)
-        running = [True]
-        program.publish(std_msgs.Bool(True))
+        running = [self.output.program_running]
+        program.publish(std_msgs.Bool(running[0]))
         order = np.array([CONTROLLER_JOINTS.index(n) for n in ROS1_JOINT_STATE_ORDER])
         unit = self.options.profile.speed_scaling_unit
         io_msg = IoStatesMessage(m)
@@ -154,8 +156,8 @@ class RosDriverServer(RosStation, DriverStation):
             pubs[0].publish(js)
             pubs[1].publish(io_msg.update(out.io))
             pubs[2].publish(std_msgs.Float64(out.speed_scaling * unit))
-            if self.follower.running != running[0]:
-                running[0] = self.follower.running
+            if out.program_running != running[0]:
+                running[0] = out.program_running
                 program.publish(std_msgs.Bool(running[0]))
             self._goal_events(m, out.decisions, out.feedback, out.results, rospy.Time.now())
 

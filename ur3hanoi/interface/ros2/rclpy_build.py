@@ -81,8 +81,8 @@ class MsgPackage:
 
 
 def driver_packages(wheels: Wheels) -> tuple[MsgPackage, ...]:
-    """``control_msgs`` (FollowJointTrajectory and its tolerances, in ``wheels``' layout) and ``ur_msgs`` (SetIO,
-    IOStates), as vendored, each file named as the package has it."""
+    """``control_msgs`` (FollowJointTrajectory and its tolerances, in ``wheels``' layout), ``ur_msgs`` (SetIO,
+    IOStates) and :func:`service_packages`, as vendored, each file named as the package has it."""
     control = MsgPackage("control_msgs", {
         "action/FollowJointTrajectory.action": msg_text("control_msgs",
                                                         f"FollowJointTrajectory-{wheels.fjt_layout}.action"),
@@ -91,7 +91,22 @@ def driver_packages(wheels: Wheels) -> tuple[MsgPackage, ...]:
     }, ("action_msgs", "builtin_interfaces", "geometry_msgs", "std_msgs", "trajectory_msgs"))
     ur = MsgPackage("ur_msgs", {f"{kind}/{name}": msg_text("ur_msgs", name) for kind, name in (
         ("msg", "Analog.msg"), ("msg", "Digital.msg"), ("msg", "IOStates.msg"), ("srv", "SetIO.srv"))}, ())
-    return control, ur
+    return control, ur, *service_packages()
+
+
+def service_packages() -> tuple[MsgPackage, ...]:
+    """What UR's example clients call besides the controller: ``controller_manager_msgs`` (list and switch
+    controllers), ``std_srvs`` (the dashboard's ``Trigger`` services) and ``ur_dashboard_msgs``
+    (``IsProgramRunning``), as vendored (Jazzy's texts)."""
+    cm = MsgPackage("controller_manager_msgs", {f"{kind}/{name}": msg_text("controller_manager_msgs", name)
+                                                for kind, name in (("msg", "ChainConnection.msg"),
+                                                                   ("msg", "ControllerState.msg"),
+                                                                   ("srv", "ListControllers.srv"),
+                                                                   ("srv", "SwitchController.srv"))},
+                    ("builtin_interfaces",))
+    return (cm, MsgPackage("std_srvs", {"srv/Trigger.srv": msg_text("std_srvs", "Trigger.srv")}, ()),
+            MsgPackage("ur_dashboard_msgs", {"srv/IsProgramRunning.srv": msg_text("ur_dashboard_msgs",
+                                                                                  "IsProgramRunning.srv")}, ()))
 
 
 def python_version(python: str) -> str:

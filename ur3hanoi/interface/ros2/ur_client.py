@@ -137,6 +137,11 @@ class RclpyDriverTransport:
         node.create_subscription(sensor_msgs.JointState, n.joint_states, self._on_joints, 10)
         node.create_subscription(ur_msg.IOStates, n.io_states, self._on_io, 10)
         node.create_subscription(std_msgs.Float64, n.speed_scaling, self._on_scaling, 10)
+        from rclpy.qos import DurabilityPolicy, QoSProfile
+
+        # Transient local as the driver publishes it: the state before this client connected arrives too.
+        node.create_subscription(std_msgs.Bool, n.program_running, self._on_program,
+                                 QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL))
         self.client = ActionClient(node, action.FollowJointTrajectory, n.follow_joint_trajectory)
         self.set_io_client = node.create_client(ur_srv.SetIO, n.set_io)
         self._set_io_type = ur_srv.SetIO
@@ -178,20 +183,27 @@ class RclpyDriverTransport:
             self.record.add(now, q)
             with self._lock:
                 s = self._state
-                self._state = DriverState(q, now, s.io, s.speed_scaling)
+                self._state = DriverState(q, now, s.io, s.speed_scaling, s.program_running)
             self._wake.set()
 
     def _on_io(self, msg: Any) -> None:
         io = io_from_msg(msg)
         with self._lock:
             s = self._state
-            self._state = DriverState(s.q, s.t_q, io, s.speed_scaling)
+            self._state = DriverState(s.q, s.t_q, io, s.speed_scaling, s.program_running)
         self._wake.set()
 
     def _on_scaling(self, msg: Any) -> None:
         with self._lock:
             s = self._state
-            self._state = DriverState(s.q, s.t_q, s.io, float(msg.data) / 100.0)  # the ROS 2 driver's percent
+            self._state = DriverState(s.q, s.t_q, s.io, float(msg.data) / 100.0,  # the ROS 2 driver's percent
+                                      s.program_running)
+
+    def _on_program(self, msg: Any) -> None:
+        with self._lock:
+            s = self._state
+            self._state = DriverState(s.q, s.t_q, s.io, s.speed_scaling, bool(msg.data))
+        self._wake.set()
 
     def latest(self) -> DriverState:
         with self._lock:

@@ -35,7 +35,8 @@ def names_for(distro: str) -> DriverNames:
     controller = "joint_trajectory_controller" if distro == "lyrical" else "scaled_joint_trajectory_controller"
     return DriverNames(joint_states="/joint_states", follow_joint_trajectory=f"/{controller}/follow_joint_trajectory",
                        set_io="/io_and_status_controller/set_io", io_states="/io_and_status_controller/io_states",
-                       speed_scaling="/speed_scaling_state_broadcaster/speed_scaling")
+                       speed_scaling="/speed_scaling_state_broadcaster/speed_scaling",
+                       program_running="/io_and_status_controller/robot_program_running")
 
 
 FEEDBACK_HZ = 20.0

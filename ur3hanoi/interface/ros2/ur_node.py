@@ -20,8 +20,10 @@ from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 from ur3hanoi.interface.ros2.errors import RclpyUnavailableError
 from ur3hanoi.interface.ros2.rclpy_env import import_interfaces, import_rclpy
 from ur3hanoi.interface.ros2.ur_driver import FEEDBACK_HZ, SPEED_SCALING_HZ, set_duration
+from ur3hanoi.interface.urdriver.controllers import ControllerManager
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1_JOINT_STATE_ORDER, DriverNames
 from ur3hanoi.interface.urdriver.io import IoStatesMessage
+from ur3hanoi.interface.urdriver.services import ServiceCall, controller_rows
 from ur3hanoi.interface.urdriver.station import CycleOutput, DriverStationOptions
 
 
@@ -35,7 +37,10 @@ class Served(Protocol):
     def names(self) -> DriverNames: ...
     @property
     def output(self) -> CycleOutput: ...
-    def goal_callback(self, request: Any, now_s: float) -> bool: ...
+    @property
+    def controllers(self) -> ControllerManager | None: ...
+    def goal_callback(self, request: Any, now_s: float, controller: str) -> bool: ...
+    def serve(self, call: ServiceCall) -> Any: ...
     def accepted(self, handle: Any, now_s: float) -> None: ...
     def execute(self, handle: Any, action: Any) -> Any: ...
     def cancel(self, handle: Any) -> None: ...
@@ -45,6 +50,7 @@ class Served(Protocol):
     def on_spawn(self, tower: Any) -> None: ...
     def on_remove(self, block: Any) -> None: ...
     def on_hold(self, seconds: float) -> None: ...
+    def on_program(self, running: bool) -> None: ...
 
 
 JOINT_STATE_ORDER = ROS1_JOINT_STATE_ORDER
@@ -99,9 +105,16 @@ class DriverNode:
             self.pub_joints = node.create_publisher(sensor_msgs.JointState, names.joint_states, 10)
             self.pub_io = node.create_publisher(ur_msg.IOStates, names.io_states, 10)
             self.pub_scaling = node.create_publisher(std_msgs.Float64, names.speed_scaling, 10)
+            # Latched as the GPIO controller's (gpio_controller.cpp @ a16a268 lines 249-266: SystemDefaultsQoS,
+            # transient_local): a client that connects later still gets the program's state.
+            from rclpy.qos import DurabilityPolicy, QoSProfile
 
-            def goal_cb(request: Any) -> Any:
-                ok = station.goal_callback(request, self._now())
+            latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+            self.pub_program = node.create_publisher(std_msgs.Bool, names.program_running, latched)
+            self._program: bool | None = None
+
+            def goal_cb(request: Any, controller: str) -> Any:
+                ok = station.goal_callback(request, self._now(), controller)
                 return GoalResponse.ACCEPT if ok else GoalResponse.REJECT
 
             def accepted_cb(handle: Any) -> None:
@@ -113,9 +126,14 @@ class DriverNode:
                 return CancelResponse.ACCEPT
 
             fjt = action.FollowJointTrajectory
-            self.server = ActionServer(node, fjt, names.follow_joint_trajectory, lambda h: station.execute(h, fjt),
-                                       goal_callback=goal_cb, handle_accepted_callback=accepted_cb,
-                                       cancel_callback=cancel_cb, callback_group=group)
+            assert station.controllers is not None
+            self.servers = [ActionServer(node, fjt, f"/{c.name}/follow_joint_trajectory",
+                                         lambda h: station.execute(h, fjt),
+                                         goal_callback=lambda r, name=c.name: goal_cb(r, name),
+                                         handle_accepted_callback=accepted_cb, cancel_callback=cancel_cb,
+                                         callback_group=group)
+                            for c in station.controllers.controllers.values() if c.action]
+            self._services(node, group)
 
             def set_io(request: Any, response: Any) -> Any:
                 response.success = station.serve_set_io(int(request.fun), int(request.pin), float(request.state),
@@ -128,6 +146,8 @@ class DriverNode:
                                      lambda m: station.on_remove(int(m.data)), 10)
             node.create_subscription(std_msgs.Float64, "ur3hanoi/hold_arm",
                                      lambda m: station.on_hold(float(m.data)), 10)
+            node.create_subscription(std_msgs.Bool, "ur3hanoi/program_running",
+                                     lambda m: station.on_program(bool(m.data)), 10)
             self.executor = MultiThreadedExecutor(num_threads=_THREADS, context=self.context)
             self.executor.add_node(node)
             self.thread = threading.Thread(target=self.executor.spin, name="rclpy-executor", daemon=True)
@@ -139,6 +159,43 @@ class DriverNode:
         self._io = IoStatesMessage(ur_msg)
         self._js = sensor_msgs.JointState(name=list(JOINT_STATE_ORDER))
         self._next_scaling = self._next_feedback = 0.0
+
+    def _services(self, node: Any, group: Any) -> None:
+        """``controller_manager``'s list and switch, the dashboard's play, stop and program_running."""
+        cm_srv, cm_msg, std_srvs, dash = import_interfaces("controller_manager_msgs.srv", "controller_manager_msgs.msg",
+                                                           "std_srvs.srv", "ur_dashboard_msgs.srv")
+        st = self.station
+
+        def listing(_request: Any, response: Any) -> Any:
+            rows = st.serve(ServiceCall("list")) or []
+            response.controller = [cm_msg.ControllerState(**row) for row in controller_rows(rows)]
+            return response
+
+        def switch(request: Any, response: Any) -> Any:
+            answer = st.serve(ServiceCall("switch", list(request.activate_controllers),
+                                          list(request.deactivate_controllers), int(request.strictness)))
+            response.ok, response.message = answer if answer is not None else (False, "the station stopped")
+            return response
+
+        def trigger(kind: str) -> Callable[[Any, Any], Any]:
+            def call(_request: Any, response: Any) -> Any:
+                answer = st.serve(ServiceCall(kind))
+                response.success, response.message = answer if answer is not None else (False, "the station stopped")
+                return response
+            return call
+
+        def running(_request: Any, response: Any) -> Any:
+            answer = st.serve(ServiceCall("running"))
+            if answer is not None:
+                response.success, response.answer, response.program_running = answer
+            return response
+
+        for srv_type, name, callback in ((cm_srv.ListControllers, "/controller_manager/list_controllers", listing),
+                                         (cm_srv.SwitchController, "/controller_manager/switch_controller", switch),
+                                         (std_srvs.Trigger, "/dashboard_client/play", trigger("play")),
+                                         (std_srvs.Trigger, "/dashboard_client/stop", trigger("stop")),
+                                         (dash.IsProgramRunning, "/dashboard_client/program_running", running)):
+            node.create_service(srv_type, name, callback, callback_group=group)
 
     def _now(self) -> float:
         return float(self.clock.now().nanoseconds) * 1e-9
@@ -155,6 +212,9 @@ class DriverNode:
         js.effort = [float(out.effort[i]) for i in self._order]
         self.pub_joints.publish(js)
         self.pub_io.publish(self._io.update(out.io))
+        if out.program_running != self._program:
+            self._program = out.program_running
+            self.pub_program.publish(self.std_msgs.Bool(data=out.program_running))
         now = time.monotonic()
         if now >= self._next_scaling:
             self._next_scaling = now + 1.0 / SPEED_SCALING_HZ

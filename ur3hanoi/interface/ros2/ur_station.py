@@ -16,7 +16,19 @@ What a client of ``ur_robot_driver`` finds (:mod:`ur3hanoi.interface.ros2.ur_dri
   up to 10 times as the driver's GPIO controller does (``false`` after that, or for a request the driver refuses);
   ``/io_and_status_controller/io_states`` (``ur_msgs/msg/IOStates``, every cycle), with the suction model's feedback
   on the calibration's pins;
-- ``/speed_scaling_state_broadcaster/speed_scaling`` (``std_msgs/msg/Float64``, **percent**, 100 Hz).
+- ``/speed_scaling_state_broadcaster/speed_scaling`` (``std_msgs/msg/Float64``, **percent**, 100 Hz);
+- ``/io_and_status_controller/robot_program_running`` (``std_msgs/msg/Bool``, transient local, on change). While the
+  External Control program is stopped (``--program-stop-at`` .. ``--program-resume-at``) the trajectory controller
+  is inactive, as the driver's ``controller_stopper`` leaves it: the running goal is aborted (INVALID_GOAL, "Current
+  goal cancelled during deactivate transition."), new goals are rejected at send_goal ("Can't accept new action
+  goals. Controller is not running." in the log);
+- ``/controller_manager/list_controllers`` and ``/controller_manager/switch_controller`` (``controller_manager_msgs``)
+  over the driver's controllers (:mod:`~ur3hanoi.interface.urdriver.controllers`), with a ``follow_joint_trajectory``
+  action for each trajectory controller (scaled, plain, passthrough): only the active one accepts goals, and all
+  drive the same simulated controller (the passthrough controller's own interpolation on the robot and its result
+  texts are not modelled); ``/dashboard_client/play``, ``stop`` (``std_srvs/Trigger``) and ``program_running``
+  (``ur_dashboard_msgs/IsProgramRunning``) start, stop and report the program
+  (:mod:`~ur3hanoi.interface.urdriver.services`).
 
 Besides: ``ur3hanoi/spawn`` and ``ur3hanoi/remove_block`` (``std_msgs/Int32``) as on the course station, and
 ``ur3hanoi/hold_arm`` (``std_msgs/Float64`` seconds: the arm is held, e.g. to provoke a path-tolerance abort).
@@ -41,6 +53,8 @@ from ur3hanoi.interface.ros2.ur_driver import goal_from_msg, names_for, preempte
 from ur3hanoi.interface.urdriver.facts import ErrorCode
 from ur3hanoi.interface.urdriver.follower import Outcome
 from ur3hanoi.interface.urdriver.goal import check_goal
+from ur3hanoi.interface.urdriver.profile import NOT_RUNNING
+from ur3hanoi.interface.urdriver.services import ServiceCall
 from ur3hanoi.interface.urdriver.station import DriverStation, DriverStationOptions
 
 READY_LINE = "ur3hanoi ros2-station: ready"
@@ -94,10 +108,11 @@ class Ros2DriverStation(DriverStation):
         if options.network not in NETWORKS:
             raise InputError(f"network {options.network!r} is invalid with the UR driver's interface (rclpy): "
                              f"expected {' or '.join(NETWORKS)}")
-        if options.profile.validation != "ros2":
+        if options.profile.validation != "ros2" or options.initial_controller is None:
             from dataclasses import replace
 
-            options = replace(options, profile=profile_for(options.distro))
+            options = replace(options, profile=profile_for(options.distro),
+                              initial_controller=names_for(options.distro).follow_joint_trajectory.split("/")[1])
         printed = out if out is not None else (lambda s: print(s, flush=True))
         self._log_line = log if log is not None else (lambda s: print(s, file=sys.stderr, flush=True))
         super().__init__(options, printed, printed)
@@ -112,13 +127,18 @@ class Ros2DriverStation(DriverStation):
         self._log_line(f"[{level.upper()}] {text}")
 
     # ------------------------------------------------------------------------------------------ the action
-    def goal_callback(self, request: Any, now_s: float) -> bool:
-        """Accept (True) or reject at send_goal (False, the reason logged) as ``validate_trajectory_msg`` does."""
+    def goal_callback(self, request: Any, now_s: float, controller: str) -> bool:
+        """Accept (True) or reject at send_goal (False, the reason logged) as ``validate_trajectory_msg`` does; a
+        goal to ``controller`` while it is not the active trajectory controller (or the program is stopped) is
+        rejected as an inactive controller rejects it."""
         goal = goal_from_msg(request, now_s)
         why = check_goal(goal, self.options.profile)
-        if why is not None:
+        active = self.program_running and self.controllers is not None and \
+            self.controllers.trajectory_controller() == controller
+        reason = NOT_RUNNING if not active else None if why is None else why.reason
+        if reason is not None:
             self.rejected_at_send_goal += 1
-            self.log.log(self.TOPIC_LOG["goal"], "error", f"goal rejected at send_goal: {why.reason}")
+            self.log.log(self.TOPIC_LOG["goal"], "error", f"goal rejected at send_goal: {reason}")
             return False
         return True
 
@@ -186,6 +206,11 @@ class Ros2DriverStation(DriverStation):
             goals = list(self._goals.values())
         for g in goals:
             g.ended.set()
+
+    def serve(self, call: ServiceCall) -> Any:
+        """A ``controller_manager`` or dashboard call, answered by the control loop (None: it stopped)."""
+        self.on_service(call)
+        return call.wait()
 
     # ------------------------------------------------------------------------------------------------ set_io
     def serve_set_io(self, fun: int, pin: int, state: float, sleep: Callable[[float], None]) -> bool:

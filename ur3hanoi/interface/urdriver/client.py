@@ -49,12 +49,13 @@ class GoalResult:
 class DriverState:
     """The latest of what the driver publishes: joint positions [rad] (controller order; None before the first
     message) with their time of arrival (the transport's :meth:`DriverTransport.now`), ``io_states``, speed scaling
-    as a fraction."""
+    as a fraction, whether the External Control program runs (``robot_program_running``; None: not heard yet)."""
 
     q: FloatArray | None = None
     t_q: float = 0.0
     io: IoStates | None = None
     speed_scaling: float | None = None
+    program_running: bool | None = None
 
 
 class GoalHandle(Protocol):

@@ -77,6 +77,8 @@ class DriverNames:
     set_io: str
     io_states: str
     speed_scaling: str
+    program_running: str = ""
+    """The latched ``std_msgs/Bool``: whether the External Control program runs (ROS 2: transient local)."""
 
 
 ROS1 = DriverNames(
@@ -85,6 +87,7 @@ ROS1 = DriverNames(
     set_io="/ur_hardware_interface/set_io",
     io_states="/ur_hardware_interface/io_states",
     speed_scaling="/speed_scaling_factor",
+    program_running="/ur_hardware_interface/robot_program_running",
 )
 """The ROS 1 ``ur_robot_driver`` (``ur3_bringup.launch``): ``speed_scaling`` is a ``std_msgs/Float64`` fraction."""
 

@@ -1,28 +1,22 @@
 """The UR driver's scaled joint trajectory controller, without a middleware: goals in, a desired joint state per
-control cycle out, results by the controller's rules.
+control cycle out, results by the controller's rules. :class:`TrajectoryFollower` ports ros_controllers'
+``JointTrajectoryController`` (noetic-devel: ``joint_trajectory_controller_impl.h``, ``init_joint_trajectory.h``,
+``tolerances.h``, ``stop_trajectory_builder.h``) with Universal Robots' scaled update; what differs on ROS 2 comes
+from its :class:`~ur3hanoi.interface.urdriver.profile.ControllerProfile`.
 
-:class:`TrajectoryFollower` is a port of ros_controllers' ``JointTrajectoryController`` (noetic-devel:
-``joint_trajectory_controller_impl.h``, ``init_joint_trajectory.h``, ``tolerances.h``, ``stop_trajectory_builder.h``)
-with Universal Robots' scaled update (``scaled_joint_trajectory_controller.h``); what differs on ROS 2 comes from
-its :class:`~ur3hanoi.interface.urdriver.profile.ControllerProfile`.
-
-- **Time.** The controller's clock ("uptime") advances by ``period x speed scaling`` every cycle, so a slider at
-  50 % or a robot slowing itself stretches the trajectory; the desired state is the trajectory sampled there.
-- **A new goal** (:meth:`TrajectoryFollower.submit`) is checked (:func:`~ur3hanoi.interface.urdriver.goal.check_goal`;
-  then the points' times: a goal all in the past is INVALID_GOAL "Dropping all N trajectory point(s) ..."), its
-  joints reordered to the controller's, and spliced in at the next cycle: points not after that time are dropped
-  (a first point at ``time_from_start`` 0 silently), a bridge segment runs from the current desired state (position,
-  velocity, acceleration) to the first point left, then one segment per pair of points
-  (:mod:`~ur3hanoi.interface.urdriver.spline`). It preempts the running goal. An empty trajectory stops the arm.
-- **Every cycle** (:meth:`TrajectoryFollower.update`) the error is ``desired - actual`` (positions by the shortest
-  angle). While the active goal's trajectory runs, a joint beyond its path tolerance aborts it with
-  PATH_TOLERANCE_VIOLATED; once it has ended, a joint inside its goal tolerances (position, and velocity below
-  ``stopped_velocity_tolerance``) counts as arrived, and the goal succeeds when all have; one still outside after
-  the goal time aborts it with GOAL_TOLERANCE_VIOLATED. Tolerances: the profile's defaults, a goal's own > 0
-  replacing them, < 0 switching them off.
-- **Cancel** (:meth:`TrajectoryFollower.cancel`) ends the active goal and ramps the desired state to rest: the
-  controller's stop trajectory (``stop_trajectory_duration``, a quintic from the current desired position and
-  velocity), lengthened where a joint would decelerate faster than its acceleration limit allows; then it holds.
+- **Time.** The controller's clock ("uptime") advances by ``period x speed scaling`` every cycle.
+- **A new goal** (:meth:`TrajectoryFollower.submit`) is checked (:func:`~ur3hanoi.interface.urdriver.goal.check_goal`)
+  and preempts the running one. ROS 1 (:func:`spliced_trajectory`): points not after the next cycle dropped (all in
+  the past: INVALID_GOAL "Dropping all N trajectory point(s) ..."), a bridge from the desired state; ROS 2
+  (:func:`points_trajectory`): every point kept, the bridge from the *measured* state at the first sample. An empty
+  trajectory stops the arm (ROS 1).
+- **Every cycle** (:meth:`TrajectoryFollower.update`) the error is ``desired - actual`` (shortest angle). While the
+  trajectory runs, a joint beyond its path tolerance aborts with PATH_TOLERANCE_VIOLATED; once it has ended, the goal
+  succeeds when every joint is inside its goal tolerances (position, ``stopped_velocity_tolerance``), or aborts with
+  GOAL_TOLERANCE_VIOLATED after the goal time. Tolerances: the profile's, a goal's own > 0 replacing, < 0 off.
+- **Cancel** and aborts: ROS 1 ramps the desired state to rest (``stop_trajectory_duration``, lengthened to the
+  deceleration limits), ROS 2 holds the measured position (``set_hold_position``).
+- **The robot program** (:meth:`TrajectoryFollower.set_running`): the controller stops and starts with it.
 
 The results are read with :meth:`TrajectoryFollower.take_outcomes`. Nothing here knows ROS, threads or MuJoCo.
 """
@@ -38,8 +32,8 @@ import numpy.typing as npt
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ErrorCode
-from ur3hanoi.interface.urdriver.goal import Rejection, TrajectoryGoal, TrajectoryPoint, check_goal
-from ur3hanoi.interface.urdriver.profile import ControllerProfile
+from ur3hanoi.interface.urdriver.goal import Rejection, TrajectoryGoal, check_goal
+from ur3hanoi.interface.urdriver.profile import NOT_RUNNING, ControllerProfile
 from ur3hanoi.interface.urdriver.spline import JointState, Segment, find_segment, segment
 
 Status = Literal["succeeded", "aborted", "preempted", "canceled"]
@@ -110,6 +104,65 @@ def shortest_angle(a: FloatArray) -> FloatArray:
     return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
+def goal_tolerances(profile: ControllerProfile, joints: tuple[str, ...], goal: TrajectoryGoal) -> _Tolerances:
+    """The active goal's tolerances: the profile's defaults, the goal's own overrides (``updateStateTolerances``)."""
+    p, n = profile, len(joints)
+    tol = _Tolerances(np.full(n, p.path_tolerance_rad), np.zeros(n), np.full(n, p.goal_tolerance_rad),
+                      np.full(n, p.stopped_velocity_tolerance), p.goal_time_s)
+    index = {name: i for i, name in enumerate(joints)}
+    for overrides, q_tol, v_tol in ((goal.path_tolerance, tol.path, tol.path_v),
+                                    (goal.goal_tolerance, tol.goal, tol.goal_v)):
+        for t in overrides:
+            if t.name in index:
+                i = index[t.name]
+                q_tol[i], v_tol[i] = _override(t.position, q_tol[i]), _override(t.velocity, v_tol[i])
+    tol.goal_time_s = _override(goal.goal_time_tolerance_s, tol.goal_time_s)
+    return tol.seal()
+
+
+def goal_states(goal: TrajectoryGoal, joints: tuple[str, ...]) -> list[JointState]:
+    """The goal's points in the controller's joint order (absent fields None)."""
+    order = [goal.joint_names.index(j) for j in joints]
+
+    def pick(values: tuple[float, ...]) -> FloatArray | None:
+        return np.array([values[k] for k in order], dtype=float) if values else None
+
+    return [JointState(np.array([p.positions[k] for k in order], dtype=float), pick(p.velocities),
+                       pick(p.accelerations)) for p in goal.points]
+
+
+def points_trajectory(goal: TrajectoryGoal, joints: tuple[str, ...], start_s: float
+                      ) -> tuple[list[Segment], tuple[float, JointState]]:
+    """ROS 2: the segments between the goal's points from controller time ``start_s``, none dropped (the controller's
+    ``Trajectory::sample``), and the first point: the controller bridges to it from the measured state at the first
+    sample (``set_point_before_trajectory_msg(time, state_current_)``)."""
+    times = [start_s + p.time_from_start_s for p in goal.points]
+    states = goal_states(goal, joints)
+    if len(states) == 1:
+        return [segment(times[0], states[0], times[0], states[0])], (times[0], states[0])
+    return ([segment(times[k], states[k], times[k + 1], states[k + 1]) for k in range(len(states) - 1)],
+            (times[0], states[0]))
+
+
+def spliced_trajectory(old: list[Segment], goal: TrajectoryGoal, joints: tuple[str, ...], now: float
+                       ) -> list[Segment] | Rejection:
+    """ROS 1: ``goal`` spliced into the running trajectory ``old`` at controller time ``now`` (points not after it
+    dropped, a bridge from the desired state there), or INVALID_GOAL when every point lies in the past."""
+    start = now + (goal.start_in_s or 0.0)
+    times = [start + p.time_from_start_s for p in goal.points]
+    first = next((k for k, t in enumerate(times) if t > now + TIME_RESOLUTION_S), None)
+    if first is None:
+        text = (f"Dropping all {len(goal.points)} trajectory point(s), as they occur before the current time.\n"
+                f"Last point is {now - times[-1]:f}s in the past.")
+        return Rejection(ErrorCode.INVALID_GOAL, text, text.replace("\n", " "))
+    states = goal_states(goal, joints)
+    bridge_from = max(start, now)
+    keep = old[find_segment(old, now):find_segment(old, bridge_from) + 1]
+    here = JointState(*old[find_segment(old, bridge_from)].sample(bridge_from))
+    new = [*keep, segment(bridge_from, here, times[first], states[first])]
+    return new + [segment(times[k], states[k], times[k + 1], states[k + 1]) for k in range(first, len(states) - 1)]
+
+
 class TrajectoryFollower:
     """The scaled joint trajectory controller (see the module docstring).
 
@@ -137,87 +190,83 @@ class TrajectoryFollower:
         self._outcomes: list[Outcome] = []
         self._feedback: Feedback | None = None
         self.running = True
+        self._measured = q.copy()  # the last cycle's measured position [rad] (ROS 2's ``state_current_``)
+        self._bridge: tuple[float, JointState] | None = None  # ROS 2: a new goal's first point, bridged at 1st sample
+        self._first_sample = False
 
     # ------------------------------------------------------------------------------------------------ goals
-    def _tolerances(self, goal: TrajectoryGoal) -> _Tolerances:
-        p = self.profile
-        n = self.n
-        tol = _Tolerances(np.full(n, p.path_tolerance_rad), np.zeros(n), np.full(n, p.goal_tolerance_rad),
-                          np.full(n, p.stopped_velocity_tolerance), p.goal_time_s)
-        index = {name: i for i, name in enumerate(self.joints)}
-        for overrides, q_tol, v_tol in ((goal.path_tolerance, tol.path, tol.path_v),
-                                        (goal.goal_tolerance, tol.goal, tol.goal_v)):
-            for t in overrides:
-                if t.name in index:
-                    i = index[t.name]
-                    q_tol[i], v_tol[i] = _override(t.position, q_tol[i]), _override(t.velocity, v_tol[i])
-        tol.goal_time_s = _override(goal.goal_time_tolerance_s, tol.goal_time_s)
-        return tol.seal()
-
-    @staticmethod
-    def _point(p: TrajectoryPoint, order: list[int]) -> JointState:
-        """A point's fields in the controller's joint order (absent ones None)."""
-        def pick(values: tuple[float, ...]) -> FloatArray | None:
-            return np.array([values[k] for k in order], dtype=float) if values else None
-
-        return JointState(np.array([p.positions[k] for k in order], dtype=float), pick(p.velocities),
-                          pick(p.accelerations))
-
     def submit(self, key: Hashable, goal: TrajectoryGoal) -> Rejection | None:
         """Accept ``goal`` (it preempts the active one) or say why not. It starts at the next :meth:`update`."""
         if not self.running:
-            text = "Can't accept new commands. Controller is not running."
-            return Rejection(ErrorCode.INVALID_GOAL, text, text)
+            return Rejection(ErrorCode.INVALID_GOAL, "", NOT_RUNNING)
         rejection = check_goal(goal, self.profile, self.joints)
         if rejection is not None:
             return rejection
         now = self.uptime + self._last_period  # the next update's controller time
+        if self.profile.from_measured and goal.points:
+            self._submit_from_measured(key, goal, now)
+            return None
         if not goal.points:
             self._preempt()
-            self.active = _Active(key, self._tolerances(goal), now, self.cycle, np.zeros(self.n, dtype=bool))
+            self.active = _Active(key, goal_tolerances(self.profile, self.joints, goal), now, self.cycle,
+                                  np.zeros(self.n, dtype=bool))
             self._stop(now)
             self.active.end_s = self.trajectory[-1].end_s
             return None
-        start = now + (goal.start_in_s or 0.0)
-        times = [start + p.time_from_start_s for p in goal.points]
-        first = next((k for k, t in enumerate(times) if t > now + TIME_RESOLUTION_S), None)
-        if first is None:
-            n = len(goal.points)
-            text = (f"Dropping all {n} trajectory point(s), as they occur before the current time.\n"
-                    f"Last point is {now - times[-1]:f}s in the past.")
-            return Rejection(ErrorCode.INVALID_GOAL, text, text.replace("\n", " "))
-        order = [goal.joint_names.index(j) for j in self.joints]
-        states = [self._point(p, order) for p in goal.points]
-        bridge_from = max(start, now)
-        keep = self.trajectory[find_segment(self.trajectory, now):find_segment(self.trajectory, bridge_from) + 1]
-        here = JointState(*self._sample(bridge_from))
-        new = [*keep, segment(bridge_from, here, times[first], states[first])]
-        new += [segment(times[k], states[k], times[k + 1], states[k + 1]) for k in range(first, len(states) - 1)]
+        new = spliced_trajectory(self.trajectory, goal, self.joints, now)
+        if isinstance(new, Rejection):
+            return new
         self._preempt()
         self.trajectory = new
-        self.active = _Active(key, self._tolerances(goal), times[-1], self.cycle, np.zeros(self.n, dtype=bool))
+        self.active = _Active(key, goal_tolerances(self.profile, self.joints, goal), new[-1].end_s, self.cycle,
+                              np.zeros(self.n, dtype=bool))
         return None
+
+    def _submit_from_measured(self, key: Hashable, goal: TrajectoryGoal, now: float) -> None:
+        new, self._bridge = points_trajectory(goal, self.joints, now + (goal.start_in_s or 0.0))  # bridged in update
+        self._preempt()
+        self.trajectory = new
+        self.active = _Active(key, goal_tolerances(self.profile, self.joints, goal), new[-1].end_s, self.cycle,
+                              np.zeros(self.n, dtype=bool))
 
     def _preempt(self) -> None:
         if self.active is not None:
             self._end("preempted", ErrorCode.SUCCESSFUL, "")
 
     def set_running(self, running: bool) -> None:
-        """Start or stop the controller (the driver's ``controller_stopper`` while the robot program is stopped on
-        the pendant): stopping preempts the active goal and brings the arm to rest; a stopped controller refuses
-        goals (INVALID_GOAL "Can't accept new commands. Controller is not running.")."""
-        if self.running and not running:
-            self._preempt()
-            self._stop(self.uptime)
+        """The controller stops and starts with the robot program (``controller_stopper``): stopping ends the
+        active goal (ROS 2: aborted with ``deactivated_text``; ROS 1: preempted), the arm stops where it is, goals are
+        refused (INVALID_GOAL, no ``error_string``); starting holds the measured position (``set_hold_position``)."""
+        if self.running and not running and self.active is not None:
+            if self.profile.deactivated_text:
+                self._end("aborted", ErrorCode.INVALID_GOAL, self.profile.deactivated_text)
+            else:
+                self._preempt()
+        if running != self.running:
+            self._hold_measured()
         self.running = running
 
     def cancel(self, key: Hashable) -> bool:
-        """Cancel goal ``key`` if it is the active one (True): it ends "canceled" and the arm ramps to rest."""
+        """Cancel goal ``key`` if it is the active one (True): it ends "canceled", the arm stops (:meth:`_halt`)."""
         if self.active is None or self.active.key != key:
             return False
         self._end("canceled", ErrorCode.SUCCESSFUL, "")
-        self._stop(self.uptime)
+        self._halt()
         return True
+
+    def _halt(self) -> None:
+        """After a cancel or an abort: ROS 2 holds the measured position, ROS 1 ramps the desired state to rest."""
+        if self.profile.from_measured:
+            self._hold_measured()
+        else:
+            self._stop(self.uptime)
+
+    def _hold_measured(self) -> None:
+        """Hold the last cycle's measured position (``set_hold_position``: ``state_current_.positions``)."""
+        z = np.zeros(self.n)
+        here = JointState(self._measured.copy(), z, z)
+        self._bridge = None
+        self.trajectory = [segment(self.uptime, here, self.uptime, here)]
 
     def _end(self, status: Status, code: ErrorCode, text: str) -> None:
         assert self.active is not None
@@ -236,9 +285,6 @@ class TrajectoryFollower:
         self.trajectory = [stop_ramp(self.desired.q, self.desired.qd, t0, self.profile.stop_trajectory_s, self.a_max)]
 
     # ---------------------------------------------------------------------------------------------- cycle
-    def _sample(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
-        return self.trajectory[find_segment(self.trajectory, t)].sample(t)
-
     def update(self, q: FloatArray, qd: FloatArray, period_s: float, scaling: float) -> JointState:
         """One control cycle of ``period_s`` [s] at speed ``scaling`` (0..1) with the arm at ``q`` [rad], ``qd``
         [rad/s]: advance the clock, sample the desired state, check the active goal. Returns the desired state
@@ -247,6 +293,13 @@ class TrajectoryFollower:
         self._last_period = period_s * scaling
         t = self.uptime + (period_s if self.profile.sample_one_period_ahead else self._last_period)
         self.uptime += self._last_period
+        self._first_sample = self._bridge is not None
+        if self._bridge is not None:
+            t_first, first = self._bridge
+            self._bridge = None
+            if t_first > t + TIME_RESOLUTION_S:
+                self.trajectory.insert(0, segment(t, JointState(q.copy(), qd.copy(), None), t_first, first))
+        self._measured = q.copy()
         index = find_segment(self.trajectory, t)
         seg = self.trajectory[index]
         p, v, a = seg.sample(t)
@@ -261,14 +314,17 @@ class TrajectoryFollower:
 
     def _check(self, active: _Active, seg: Segment, last: bool, err_q: FloatArray, err_qd: FloatArray) -> None:
         tol, prof = active.tolerances, self.profile
-        if self.uptime < seg.end_s - TIME_RESOLUTION_S:
+        moving = self.uptime < seg.end_s - TIME_RESOLUTION_S
+        if moving or self._first_sample:  # ROS 2 checks the first sample even when it is the last point
             active.max_path_error = max(active.max_path_error, float(np.abs(err_q).max()))
             bad = _outside(err_q, err_qd, tol.bounds[0], tol.bounds[1])
             if bad is not None:
                 self._end("aborted", ErrorCode.PATH_TOLERANCE_VIOLATED,
                           prof.path_error.format(joint=self.joints[bad], error=float(err_q[bad]), late=0.0))
                 if prof.hold_on_path_abort:
-                    self._stop(self.uptime)
+                    self._halt()
+                return
+        if moving:
             return
         if not last:
             return
@@ -295,7 +351,7 @@ class TrajectoryFollower:
         self._end("aborted", ErrorCode.GOAL_TOLERANCE_VIOLATED,
                   prof.goal_error.format(joint=self.joints[joint], error=float(err_q[joint]), late=late))
         if prof.hold_on_path_abort:
-            self._stop(self.uptime)
+            self._halt()
 
     # ------------------------------------------------------------------------------------------- reading
     def feedback(self) -> Feedback | None:

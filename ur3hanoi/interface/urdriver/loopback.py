@@ -55,7 +55,7 @@ class LoopbackTransport:
 
     def latest(self) -> DriverState:
         out = self.station.output
-        return DriverState(out.q, out.t_s, out.io, out.speed_scaling)
+        return DriverState(out.q, out.t_s, out.io, out.speed_scaling, out.program_running)
 
     def send_goal(self, goal: TrajectoryGoal) -> LoopbackGoal:
         self._sent += 1

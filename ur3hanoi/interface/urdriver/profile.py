@@ -43,6 +43,15 @@ class ControllerProfile:
             [rad] and ``late`` [s]. Empty: the controller sets none.
         speed_scaling_unit: what the driver publishes for a speed scaling of 1 (ROS 1: 1.0; ROS 2: 100.0, percent).
         set_io_waits: True (ROS 2): ``set_io`` answers once the output changed; False (ROS 1): once queued.
+        from_measured: True (ROS 2's scaled controller, Humble and Jazzy: ``scaled_joint_trajectory_controller.cpp``
+            @ a16a268 lines 134-146 and 280-284, ``interpolate_from_desired_state`` and ``open_loop_control`` false
+            by default): a new trajectory starts from the *measured* state at its first sample (no point is
+            dropped, a point at ``time_from_start`` 0 is commanded at once), and an abort or a cancel holds the
+            measured position (``set_hold_position``); False (ROS 1): from the desired state, past points dropped.
+        deactivated_text: the ``error_string`` of the goal that runs when the controller is stopped because the
+            robot program stopped: ROS 2 aborts it (``on_deactivate``, ros2_controllers jazzy
+            ``joint_trajectory_controller.cpp`` @ ed360c9 lines 1255-1267, humble @ ad559d9 lines 1055-1067); empty:
+            ROS 1 preempts it without a result (``stopping`` -> ``preemptActiveGoal`` -> ``setCanceled``).
     """
 
     name: str
@@ -61,6 +70,8 @@ class ControllerProfile:
     success_text: str
     speed_scaling_unit: float
     set_io_waits: bool
+    from_measured: bool = False
+    deactivated_text: str = ""
 
 
 ROS1_SCALED = ControllerProfile(
@@ -77,9 +88,14 @@ ROS2_SCALED = ControllerProfile(
     sample_one_period_ahead=False, validation="ros2", reject_nonzero_final_velocity=True,
     path_error="Aborted due to path tolerance violation",
     goal_error="Aborted due to goal_time_tolerance exceeding by {late:f} seconds",
-    success_text="Goal successfully reached!", speed_scaling_unit=100.0, set_io_waits=True,
+    success_text="Goal successfully reached!", speed_scaling_unit=100.0, set_io_waits=True, from_measured=True,
+    deactivated_text="Current goal cancelled during deactivate transition.",
 )
 """The ROS 2 driver's ``scaled_joint_trajectory_controller`` on Jazzy (ros2_controllers' texts)."""
 
 JTC_ERROR_TEXTS = {"path_error": "{joint} path error {error:f}", "goal_error": "{joint} goal error {error:f}"}
 """The plain ROS 1 JTC's ``error_string`` formats (``std::to_string`` of the error), for a profile of it."""
+
+NOT_RUNNING = "Can't accept new action goals. Controller is not running."
+"""What both controllers log when a goal arrives while they are stopped (ROS 1 ``goalCB``: INVALID_GOAL without an
+``error_string``; ROS 2 ``goal_received_callback``, jazzy line 1407-1411: rejected at ``send_goal``)."""

@@ -88,6 +88,7 @@ class DriverRecords:
         self.counts = {"received": 0, "accepted": 0, "rejected": 0, "succeeded": 0, "aborted": 0, "canceled": 0,
                        "preempted": 0, "io_calls": 0, "io_refused": 0}
         self._lost: tuple[int, float | None] | None = None  # (cycle, wall time published) of a fallen vacuum switch
+        self.program: deque[dict[str, Any]] = deque(maxlen=kept)  # the External Control program's stops and starts
 
     def received(self, key: Hashable, goal: TrajectoryGoal, t: float, decision: Rejection | None) -> None:
         """A goal was decided at world time ``t``."""
@@ -112,6 +113,10 @@ class DriverRecords:
         if rec is not None:
             rec.t_end, rec.outcome = t, outcome
             rec.max_path_error_rad = max(rec.max_path_error_rad, outcome.max_path_error_rad)
+
+    def program_changed(self, t: float, running: bool) -> None:
+        """The External Control program stopped (``running`` False) or started at world time ``t``."""
+        self.program.append({"t": _r(t), "running": running})
 
     def io_call(self, t: float, fun: int, pin: int, state: float, success: bool) -> None:
         self.counts["io_calls" if success else "io_refused"] += 1

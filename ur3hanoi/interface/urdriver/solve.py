@@ -21,6 +21,10 @@
    :class:`~ur3hanoi.interface.urdriver.client.DriverGoalError` (exit 2) with the driver's code and error string; a
    goal past its timeout: canceled, suction off,
    :class:`~ur3hanoi.errors.DriverError`; joint states that stop: the same.
+   **The External Control program** (the driver's latched ``robot_program_running``): stopped before the start, the
+   solve refuses (:class:`~ur3hanoi.errors.DriverError`, "start the External Control program on the pendant");
+   stopped mid-solve (the controller stops with it: ROS 2 aborts the goal, ROS 1 preempts it), suction off and
+   :class:`~ur3hanoi.errors.ProgramStoppedError` (exit 3): the arm stopped where it was.
 6. **The path.** Every joint state received from the plan's start to its end is recorded by the transport
    (:class:`~ur3hanoi.interface.urdriver.joint_record.JointRecord`); after a solve, the largest distance of the
    executed suction point from the plan's path (each joint state against its goal's stretch), overall and on the
@@ -37,11 +41,11 @@ from typing import Literal
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.errors import DriverError, SuctionFaultError
+from ur3hanoi.errors import DriverError, ProgramStoppedError, SuctionFaultError
 from ur3hanoi.hanoi import Move, block_colour
 from ur3hanoi.interface.common.moves import describe_move
-from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverTransport, GoalHandle
-from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, FUN_SET_DIGITAL_OUT
+from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverTransport, GoalHandle, GoalResult
+from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, FUN_SET_DIGITAL_OUT, ErrorCode
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
 from ur3hanoi.interface.urdriver.path_deviation import PathDeviation, path_deviation, stretch_windows
 from ur3hanoi.interface.urdriver.plan_goals import Stretch, move_goal, plan_stretches
@@ -63,6 +67,7 @@ class DriverSolveConfig:
     state_timeout_s: float = 2.0
     rest_timeout_s: float = 3.0
     poll_s: float = 0.002
+    program_wait_s: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -136,6 +141,9 @@ class _Solve:
         while not handle.done():
             tr.wait(cfg.poll_s)
             now, st = self.tr.now(), tr.latest()
+            if st.program_running is False:  # the controller ends the goal too: its result says how
+                self.sleep(cfg.program_wait_s, handle.done)
+                raise self.program_stopped(label, handle.result() if handle.done() else None)
             tau += (now - last) * (1.0 if st.speed_scaling is None else st.speed_scaling)
             last = now
             if carrying and not self.held():
@@ -152,11 +160,33 @@ class _Solve:
                 raise DriverError(f"{label} did not finish within {allowed:.1f} s of trajectory time (the speed "
                                   f"scaling the driver reports counted): canceled, suction off")
         result = handle.result()
+        # The controller's end and the program's topic travel apart: a goal ended as a stop ends it waits for both.
+        if result.status != "succeeded" and (result.status == "preempted" or result.code == ErrorCode.INVALID_GOAL) \
+                and self.sleep(cfg.program_wait_s, lambda: tr.latest().program_running is False):
+            raise self.program_stopped(label, result)
         if result.status != "succeeded":
             self.suction(False)
             verb = "rejected" if result.status == "rejected" else "ended"
             raise DriverGoalError(f"the driver's controller {verb} {label}: {result.describe()}; suction off, "
                                   "the solve stops", result)
+
+    def check_program(self) -> None:
+        """Refuse to start while the External Control program is stopped (its state is latched: it arrives with the
+        connection; a driver that never says is let through)."""
+        self.sleep(self.cfg.program_wait_s, lambda: self.tr.latest().program_running is not None)
+        if self.tr.latest().program_running is False:
+            raise DriverError(f"the robot program is not running (robot_program_running is false on {self.tr.where}):"
+                              " the driver's trajectory controller refuses every goal until it runs; start the "
+                              "External Control program on the pendant")
+
+    def program_stopped(self, label: str, result: GoalResult | None) -> ProgramStoppedError:
+        """Suction off; the error of a program that stopped during ``label``."""
+        self.suction(False)
+        how = "" if result is None else f"; the controller: {result.describe()}"
+        return ProgramStoppedError(
+            f"the External Control program stopped on the robot during {label} (robot_program_running false{how}):"
+            " the arm stopped where it was, suction off; check the blocks, start the program on the pendant and "
+            "run again")
 
     def _cancel(self, handle: GoalHandle) -> None:
         if not handle.done():
@@ -193,6 +223,7 @@ class _Solve:
 
     def start(self) -> float:
         """Bring the arm to where the plan starts, or refuse (see the module docstring); returns the wall time."""
+        self.check_program()
         q0, q = self.plan.trajectory.q[0], self.q()
         off = np.abs(q - q0)
         far = float(off.max())
@@ -247,8 +278,9 @@ def run_driver_solve(transport: DriverTransport, plan: Plan, wiring: SuctionWiri
     Raises:
         SuctionFaultError: a block was missing or dropped; the arm has halted (suction off, home).
         DriverGoalError: the controller rejected or aborted a goal (suction off).
-        DriverError: the arm is far from the plan's start (``far_start="refuse"``), a goal timed out, the joint
-            states stopped, or ``set_io`` failed.
+        ProgramStoppedError: the External Control program stopped mid-solve (suction off, the arm where it was).
+        DriverError: the arm is far from the plan's start (``far_start="refuse"``), the program is not running, a
+            goal timed out, the joint states stopped, or ``set_io`` failed.
     """
     cfg = config if config is not None else DriverSolveConfig()
     run = _Solve(transport, plan, wiring, cfg, log if log is not None else (lambda _s: None))

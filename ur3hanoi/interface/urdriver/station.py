@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.interface.common.station import ServerCore, ServerOptions
+from ur3hanoi.interface.urdriver.controllers import ControllerManager
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS
 from ur3hanoi.interface.urdriver.follower import Feedback, Outcome, TrajectoryFollower
 from ur3hanoi.interface.urdriver.goal import Rejection, TrajectoryGoal
@@ -34,6 +35,7 @@ from ur3hanoi.interface.urdriver.profile import ROS1_SCALED, ControllerProfile
 from ur3hanoi.interface.urdriver.records import DriverRecords
 
 if TYPE_CHECKING:
+    from ur3hanoi.interface.urdriver.services import ServiceCall
     from ur3hanoi.sim.config import SimConfig
     from ur3hanoi.sim.servo_world import ServoWorld
 
@@ -45,11 +47,19 @@ class DriverStationOptions(ServerOptions):
     Attributes:
         speed_scaling: the pendant's speed slider, in (0, 1].
         profile: the controller's defaults and rules (ROS 1 or ROS 2).
+        program_stop_at_s, program_resume_at_s: fault injection: the External Control program stops (as when the
+            pendant's stop button is pressed) and starts again at these world times [s] (None: never).
+        initial_controller: ROS 2: the controller manager's initial motion controller
+            (:class:`~ur3hanoi.interface.urdriver.controllers.ControllerManager`); None (ROS 1): no controller
+            manager, the trajectory controller runs whenever the program does.
     """
 
     rate_hz: float | None = None
     speed_scaling: float = 1.0
     profile: ControllerProfile = ROS1_SCALED
+    program_stop_at_s: float | None = None
+    program_resume_at_s: float | None = None
+    initial_controller: str | None = None
 
 
 @dataclass(frozen=True)
@@ -64,6 +74,7 @@ class CycleOutput:
         decisions: goals decided this cycle: (key, None = accepted, or the rejection).
         feedback: the active goal's (key, feedback), or None.
         results: goals that ended this cycle: (key, outcome).
+        program_running: whether the External Control program runs (the driver's ``robot_program_running``).
     """
 
     t_s: float
@@ -76,6 +87,7 @@ class CycleOutput:
     decisions: tuple[tuple[Hashable, Rejection | None], ...] = ()
     feedback: tuple[Hashable, Feedback] | None = None
     results: tuple[tuple[Hashable, Outcome], ...] = ()
+    program_running: bool = True
 
 
 class DriverStation(ServerCore["ServoWorld"]):
@@ -96,6 +108,12 @@ class DriverStation(ServerCore["ServoWorld"]):
         self._decisions: list[tuple[Hashable, Rejection | None]] = []
         self._switch = False
         self._effort_ids = w.servo.act_ids
+        self._program_done: set[float] = set()
+        self.program_running = True
+        self.controllers = None if options.initial_controller is None else ControllerManager(options.initial_controller)
+        self._owner = None if self.controllers is None else self.controllers.trajectory_controller()
+        if options.program_stop_at_s is not None and options.program_stop_at_s <= 0.0:
+            self._scheduled_program()  # stopped from the start: the first output says so
         self.output = self._output((), None, ())
 
     def _build_world(self, config: SimConfig, n_blocks: int) -> ServoWorld:
@@ -151,14 +169,51 @@ class DriverStation(ServerCore["ServoWorld"]):
         elif kind == "io":
             self.records.io_call(t, *payload)
         elif kind == "program":
-            self.follower.set_running(payload)
-            self.log.log(self.TOPIC_LOG[kind], "warn", f"the robot program {'runs' if payload else 'stopped'}")
+            self.set_program(bool(payload))
+        elif kind == "service":
+            payload.answer(self)
         else:
             super()._handle(kind, payload)
+
+    def on_service(self, request: ServiceCall) -> None:
+        """A ``controller_manager`` or dashboard call (any thread): answered in the next control cycle."""
+        self.inbox.offer("service", request)
+
+    def sync_controllers(self) -> None:
+        """The follower runs while the program does and (ROS 2) a trajectory controller is active; a switch to
+        another one ends the running goal as a deactivation does."""
+        owner = None if self.controllers is None else self.controllers.trajectory_controller()
+        running = self.program_running and (self.controllers is None or owner is not None)
+        if owner != self._owner and self.follower.running:
+            self.follower.set_running(False)
+        self._owner = owner
+        self.follower.set_running(running)
+
+    def set_program(self, running: bool) -> None:
+        """The External Control program stops or starts (control thread): the controllers with it (the driver's
+        ``controller_stopper``); ``io_states`` and the joint states go on."""
+        if running == self.program_running:
+            return
+        self.program_running = running
+        if self.controllers is not None:
+            self.controllers.program(running)
+        self.sync_controllers()
+        self.records.program_changed(self.world.time, running)
+        self.log.log(self.TOPIC_LOG["program"], "warn", "the External Control program runs again" if running else
+                     "the External Control program stopped: the trajectory controller is stopped, goals are refused")
+
+    def _scheduled_program(self) -> None:
+        """``--program-stop-at`` / ``--program-resume-at``: each once, when the world time reaches it."""
+        opts, t = self.options, self.world.time
+        for at, running in ((opts.program_stop_at_s, False), (opts.program_resume_at_s, True)):
+            if at is not None and at not in self._program_done and t >= at - 1e-9:
+                self._program_done.add(at)
+                self.set_program(running)
 
     # ------------------------------------------------------------------------------------------------ cycle
     def _step(self) -> None:
         """One control cycle: the IO writes, the controller, the robot, the feedback on the inputs."""
+        self._scheduled_program()
         w, period = self.world, self.world.config.period_s
         self.io.cycle()
         wiring = self.station.wiring
@@ -191,7 +246,7 @@ class DriverStation(ServerCore["ServoWorld"]):
         w = self.world
         effort = w.scene.data.actuator_force[self._effort_ids]  # a copy (fancy indexing)
         return CycleOutput(w.time, CONTROLLER_JOINTS, w.q, w.qd, effort, self.io.states, w.speed_scaling, decisions,
-                           feedback, results)
+                           feedback, results, self.program_running)
 
     # ------------------------------------------------------------------------------------------------ report
     def _report_motion(self) -> dict[str, Any]:
@@ -201,8 +256,10 @@ class DriverStation(ServerCore["ServoWorld"]):
                 "goals": self.records.summary(),
                 "goal_records": [g.as_dict() for g in self.records.goals],
                 "io_calls": list(self.records.io_calls),
-                "halts": [h.as_dict() for h in self.records.halts]}
+                "halts": [h.as_dict() for h in self.records.halts],
+                "program": list(self.records.program)}
 
     def _report_final(self) -> dict[str, Any]:
-        return {"goal_active": self.follower.active is not None, "program_running": self.follower.running,
+        return {"goal_active": self.follower.active is not None, "program_running": self.program_running,
+                **({} if self.controllers is None else {"active_controllers": sorted(self.controllers.active)}),
                 "speed_scaling": round(self.world.speed_scaling, 6)}
