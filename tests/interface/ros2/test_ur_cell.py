@@ -1,7 +1,8 @@
 """``teach --driver ur`` and ``check-arm --driver ur`` on ROS 2 (ur3hanoi.interface.ros2.ur_cell, a real rclpy from
 the ``ros2-env`` Jazzy environment) against ``ros2-station --driver ur``, inside a private network namespace, on a
 station set up as a student would (tests/support/student_cell.py): the check, a pose recorded by the non-interactive
-form, then a session through the pseudo-terminal that jogs to the three contacts by trajectory goals, holds a block
+form (with the program stopped on the pendant: the check fails the program and the controller, recording works),
+then a session through the pseudo-terminal that jogs to the three contacts by trajectory goals, holds a block
 with ``v`` and writes the calibration and the table key; then the check on the other robot's calibration fails."""
 
 from __future__ import annotations
@@ -36,8 +37,12 @@ def test_check_record_and_a_terminal_session_on_the_ros2_driver(tmp_path: Path) 
         f"{station} > {tmp_path}/st.out 2> {tmp_path}/st.err &", "ST=$!", f"wait_ready {tmp_path}/st.out || exit 90",
         f"{check} --calibration {tmp_path}/student.yaml > {tmp_path}/check.json 2> {tmp_path}/check.err; "
         f"echo $? > {tmp_path}/check.code",
+        f"{pre} {sys.executable} -m tests.support.pendant stop > {tmp_path}/stop.out 2>&1 || exit 91",
+        f"{check} --calibration {tmp_path}/student.yaml > {tmp_path}/stopped.json 2> /dev/null; "
+        f"echo $? > {tmp_path}/stopped.code",
         f"{pre} $UR3HANOI teach --via ros2 --driver ur --base lab_real -o {tmp_path}/now.yaml --record-now 1,3 "
         f"> {tmp_path}/now.out 2>&1; echo $? > {tmp_path}/now.code",
+        f"{pre} {sys.executable} -m tests.support.pendant play > {tmp_path}/play.out 2>&1 || exit 92",
         f"{pre} {sys.executable} -m tests.support.student_cell {tmp_path} 3 --via ros2 --driver ur {ACCEPT} "
         f"> {tmp_path}/session.json 2> {tmp_path}/session.err",
         f"{check} --calibration ur3e_sim > {tmp_path}/other.json 2> /dev/null; echo $? > {tmp_path}/other.code",
@@ -48,6 +53,12 @@ def test_check_record_and_a_terminal_session_on_the_ros2_driver(tmp_path: Path) 
     assert int((tmp_path / "check.code").read_text()) == 0, (tmp_path / "check.err").read_text()
     assert checks["speed"]["status"] == "warn" and checks["speed"]["value"] == pytest.approx(1.0, abs=1e-6)
     assert checks["model"]["status"] == "ok" and checks["home"]["status"] == "ok"
+    assert checks["program"]["status"] == "ok" and checks["controller"]["value"] == "active"
+    # The program stopped on the pendant (the dashboard's stop): the program and the controller fail; recording works.
+    stopped = {c["name"]: c for c in json.loads((tmp_path / "stopped.json").read_text())["checks"]}
+    assert int((tmp_path / "stopped.code").read_text()) == 2
+    assert stopped["program"]["status"] == "fail" and stopped["controller"]["status"] == "fail"
+    assert "scaled_joint_trajectory_controller is inactive (controller_manager)" in stopped["controller"]["line"]
     assert checks["suction"]["status"] == "ok", checks["suction"]
     assert int((tmp_path / "now.code").read_text()) == 0, (tmp_path / "now.out").read_text()
     assert np.allclose(load_taught(tmp_path / "now.yaml").points[0].q, load_station("lab_real").q_home_array,

@@ -71,9 +71,15 @@ class CellLink(DriverTransport, Protocol):
     """A :class:`~ur3hanoi.interface.urdriver.client.DriverTransport` with what the commands before a solve need."""
 
     history: JointHistory
+    action: str
+    """The trajectory controller's action (``/scaled_pos_joint_traj_controller/follow_joint_trajectory``)."""
 
     def program_running(self) -> bool | None:
         """The driver's latched ``robot_program_running`` (None: nothing received yet)."""
+
+    def controller_state(self) -> str | None:
+        """The scaled trajectory controller's state from the controller manager (``active``, ``inactive``, ``not
+        loaded``), None when it cannot be asked."""
 
     def simulated(self) -> bool:
         """True for ur3hanoi's own ``ros-station --driver ur`` / ``ros2-station --driver ur`` (no pendant)."""

@@ -4,8 +4,9 @@ Each check gives one :class:`Check` (``ok``, ``warn``, ``fail`` or ``skip``) and
 
 - ``driver``: the driver answers (joint states, ``io_states``, the trajectory action, ``set_io``: the link's connect);
 - ``program``: the External Control program runs (the driver's latched ``robot_program_running``);
-- ``controller``: the scaled trajectory controller can execute: its action server answers and the program runs
-  (the drivers stop it with the program);
+- ``controller``: the scaled trajectory controller can execute: ``active`` in the controller manager's list where
+  the driver offers one (ROS 2), else its action server answers; and the program runs (the drivers stop it with the
+  program);
 - ``speed``: the speed slider (the driver's speed scaling with the arm at rest): above :data:`FIRST_RUN_SLIDER` a
   warning for a first run, 0 (paused) a failure;
 - ``model``: the arm against the calibration's robot, by what the driver shows of it: its control rate (a CB3 UR3
@@ -83,11 +84,24 @@ def check_program(link: CellLink) -> Check:
 
 
 def check_controller(link: CellLink, program: Check) -> Check:
+    state = link.controller_state()
+    name = link_controller(link)
+    if state is not None and state != "active":
+        return Check("controller", "fail", f"{name} is {state} (controller_manager): "
+                                           + ("the driver stops it with the program: start the program"
+                                              if program.status == "fail" else "activate it (switch_controller)"),
+                     state)
     if program.status == "fail":
-        return Check("controller", "fail", "the scaled trajectory controller does not execute while the program is "
-                                           "stopped (its goals are refused)", False)
-    return Check("controller", "ok", "the scaled trajectory controller's action server answers" +
-                 ("" if program.status == "ok" else " (whether the program runs is not known)"), True)
+        return Check("controller", "fail", f"{name} does not execute while the program is stopped (its goals are "
+                                           "refused)", state or False)
+    how = "active (controller_manager)" if state == "active" else "its action server answers"
+    return Check("controller", "ok", f"{name}: {how}" +
+                 ("" if program.status == "ok" else " (whether the program runs is not known)"), state or True)
+
+
+def link_controller(link: CellLink) -> str:
+    """The trajectory controller's name, from its action's (``/scaled_pos_joint_traj_controller/...``)."""
+    return link.action.strip("/").split("/")[0]
 
 
 def check_speed(link: CellLink) -> Check:
