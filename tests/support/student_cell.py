@@ -77,9 +77,11 @@ def main() -> int:
     """``python -m tests.support.student_cell DIR N [TEACH OPTIONS...]``: teach (through a pseudo-terminal) the station
     of ``DIR/student.yaml`` at most N poses, with ``teach --base lab_real -o DIR/taught.yaml --table
     DIR/lab2_data.yaml --station-out DIR/station.yaml TEACH OPTIONS``; writes ``DIR/transcript.txt`` and prints what
-    the operator saw as one JSON line (the exit status in it)."""
+    the operator saw as one JSON line (the exit status in it, the wall time [s] until ``f`` and from ``f`` to
+    teach's end: the calibration and the table written)."""
     import json
     import sys
+    import time
 
     import pexpect
 
@@ -89,15 +91,17 @@ def main() -> int:
     argv = ["-m", "ur3hanoi.cli", "teach", "--base", "lab_real", "-o", str(folder / "taught.yaml"), "--table",
             str(folder / "lab2_data.yaml"), "--station-out", str(folder / "station.yaml"), *extra]
     with (folder / "raw.txt").open("w") as raw:
+        t0 = time.perf_counter()
         child = pexpect.spawn(sys.executable, argv, encoding="utf-8", dimensions=(30, 150), timeout=60)
         child.logfile_read = raw
         try:
             seen = teach_session(child, load_station("lab_real"), load_station(folder / "student.yaml"),
                                  max_poses=n)
+            t1 = time.perf_counter()
             child.expect(pexpect.EOF, timeout=180)
         finally:
             child.close(force=True)
-    seen["exit"] = child.exitstatus
+    seen.update(exit=child.exitstatus, teach_s=round(t1 - t0, 2), finish_s=round(time.perf_counter() - t1, 2))
     (folder / "transcript.txt").write_text(screen_text((folder / "raw.txt").read_bytes().decode()))
     print(json.dumps(seen))
     return 0
