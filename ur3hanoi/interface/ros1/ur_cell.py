@@ -9,9 +9,20 @@ latched ``/ur_hardware_interface/robot_program_running``) with what the commands
 
 from __future__ import annotations
 
+import logging
+
 from ur3hanoi.interface.ros1.ur_client import RosDriverTransport
 from ur3hanoi.interface.urdriver.cell import JointHistory
 from ur3hanoi.interface.urdriver.facts import ROS1
+
+
+class _OldGoalFilter(logging.Filter):
+    """Drops actionlib's "on a goal handle that we're not tracking": ``SimpleActionClient`` tracks only the newest
+    goal, and the driver goes on reporting the previous jog step's (succeeded) goal for a while after the next one is
+    sent; the line would land in teach's live screen."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return "on a goal handle that we're not tracking" not in record.getMessage()
 
 
 class RosCellLink(RosDriverTransport):
@@ -21,6 +32,10 @@ class RosCellLink(RosDriverTransport):
         super().__init__(master_uri, connect_timeout_s)
         self.history = self.record = JointHistory()
         self.action = ROS1.follow_joint_trajectory
+
+    def connect(self) -> None:
+        super().connect()
+        logging.getLogger("rosout").addFilter(_OldGoalFilter())
 
     def program_running(self) -> bool | None:
         return self.latest().program_running
