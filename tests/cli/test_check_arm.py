@@ -99,3 +99,25 @@ def test_no_driver_fails_the_first_check(tmp_path):
     with roscore(env):
         code, checks, _ = check(env, "lab_real", "--wait", "1")
     assert code == 2 and list(checks) == ["driver"] and checks["driver"]["status"] == "fail"
+
+
+def test_on_the_course_topics_only_the_driver_and_home_are_told(tmp_path):
+    env = ros_env(free_port(), tmp_path)
+    with roscore(env), station(env, tmp_path, "--calibration", "lab_sim"):
+        result = run(ur3hanoi_cmd("check-arm", "--via", "ros", "--calibration", "lab_sim"), env, 60)
+        far = run(ur3hanoi_cmd("check-arm", "--via", "ros", "--calibration",
+                               str(variant_of("lab_sim", tmp_path, {"robot.home_deg": [80, -90, 90, -90, -90, 0]}))),
+                  env, 60)
+    lines = result.stdout.strip().splitlines()
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert lines[0].startswith("ok    driver     the course's driver publishes ur3/position")
+    assert lines[1].startswith("ok    home       0.000 rad from home")
+    assert [line.split()[0] for line in lines[2:7]] == ["skip"] * 5
+    assert far.returncode == 2 and "fail  home       0.698 rad from home" in far.stdout
+
+
+def variant_of(name: str, folder: Path, change: dict[str, Any]) -> Path:
+    from ur3hanoi.io.resources import station_file
+
+    (folder / "student.yaml").write_text(station_file(name).read_text())
+    return variant(folder, f"{name}_changed", change)

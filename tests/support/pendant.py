@@ -1,6 +1,6 @@
-"""The pendant's play and stop, as UR's ROS 2 driver offers them (``/dashboard_client/play``, ``/dashboard_client/stop``,
-``std_srvs/srv/Trigger``): ``python -m tests.support.pendant play|stop`` with rclpy (run it in the ``ros2-env``
-environment); prints the dashboard's answer and exits 0 when it succeeded."""
+"""The pendant's play and stop, as UR's ROS 2 driver offers them (``/dashboard_client/play``,
+``/dashboard_client/stop``, ``std_srvs/srv/Trigger``): ``python -m tests.support.pendant play|stop`` with rclpy (run
+it in the ``ros2-env`` environment); prints the dashboard's answer and exits 0 when it succeeded."""
 
 from __future__ import annotations
 

@@ -101,25 +101,34 @@ def suction_text(link: DriverTransport, station: Station) -> str:
             f"AI{w.sensor_input}={io.analog_in[w.sensor_input][1]:.2f} V")
 
 
+def suction_outputs(station: Station) -> tuple[int, ...]:
+    """The outputs the suction needs on, in the order they are switched on: the vacuum generator's first where the
+    calibration names one (``io.vacuum_generator_output``), then the cup's; off in the reverse order."""
+    generator = getattr(station.wiring, "generator", None)  # the io section's generator pin, where it has one
+    return (station.wiring.output,) if generator is None else (int(generator), station.wiring.output)
+
+
 def switch_suction(link: DriverTransport, station: Station, on: bool) -> str:
-    """``set_io`` on the calibration's suction output, then wait (at most :data:`IO_READBACK_S`) until ``io_states``
-    shows it; returns what ``io_states`` shows.
+    """``set_io`` on the calibration's suction outputs (:func:`suction_outputs`), then wait (at most
+    :data:`IO_READBACK_S`) until ``io_states`` shows them; returns what ``io_states`` shows.
 
     Raises:
-        DriverError: ``set_io`` answered ``success = false``, or the output did not show in ``io_states``.
+        DriverError: ``set_io`` answered ``success = false``, or an output did not show in ``io_states``.
     """
-    pin = station.wiring.output
-    if not link.set_io(FUN_SET_DIGITAL_OUT, pin, 1.0 if on else 0.0):
-        raise DriverError(f"set_io(fun={FUN_SET_DIGITAL_OUT}, pin={pin}, state={int(on)}) answered success = false "
-                          f"on {link.where}: is io.suction_output right and the robot program running?")
+    pins = suction_outputs(station)
+    for pin in pins if on else pins[::-1]:
+        if not link.set_io(FUN_SET_DIGITAL_OUT, pin, 1.0 if on else 0.0):
+            raise DriverError(f"set_io(fun={FUN_SET_DIGITAL_OUT}, pin={pin}, state={int(on)}) answered success = "
+                              f"false on {link.where}: is the calibration's io section right and the robot program "
+                              "running?")
     end = time.monotonic() + IO_READBACK_S
     while time.monotonic() < end:
         io = link.latest().io
-        if io is not None and io.digital_out[pin] == on:
+        if io is not None and all(io.digital_out[pin] == on for pin in pins):
             return suction_text(link, station)
         link.wait(0.02)
-    raise DriverError(f"set_io answered success but io_states still shows DO{pin}={int(not on)} after "
-                      f"{IO_READBACK_S:g} s on {link.where}")
+    raise DriverError(f"set_io answered success but io_states does not show DO{'/'.join(map(str, pins))}="
+                      f"{int(on)} after {IO_READBACK_S:g} s on {link.where}")
 
 
 class DriverArm:
@@ -193,10 +202,11 @@ class DriverArm:
         """Suction off if teach switched it on (the cup must not hold a block after the session), then disconnect."""
         try:
             if self.suction_on:
-                self.link.set_io(FUN_SET_DIGITAL_OUT, self.station.wiring.output, 0.0)
+                for pin in suction_outputs(self.station)[::-1]:
+                    self.link.set_io(FUN_SET_DIGITAL_OUT, pin, 0.0)
         finally:
             self.link.close()
 
 
 __all__ = ["HISTORY_S", "IO_READBACK_S", "PROGRAM_STOPPED", "CellLink", "DriverArm", "JointHistory",
-           "jog_speed_fraction", "suction_text", "switch_suction"]
+           "jog_speed_fraction", "suction_outputs", "suction_text", "switch_suction"]
