@@ -5,7 +5,6 @@ is stopped, and the suction switched and read back from io_states (the generator
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 import pytest

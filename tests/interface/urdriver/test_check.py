@@ -45,10 +45,10 @@ def test_a_stopped_program_a_far_home_and_a_wrong_pin_fail(link: LoopbackCell) -
     link.wait(0.0)
     program = check_program(link)
     assert program.status == "fail" and check_controller(link, program).status == "fail"
-    far = dataclasses.replace(st, q_home=tuple(np.asarray(st.q_home) + [HOME_FAR_RAD + 0.1, 0, 0, 0, 0, 0]))
+    far = dataclasses.replace(st, q_home=tuple(np.asarray(st.q_home) + np.array([HOME_FAR_RAD + 0.1, 0, 0, 0, 0, 0])))
     home = check_home(link, far)
     assert home.status == "fail" and home.value == pytest.approx(HOME_FAR_RAD + 0.1, abs=1e-6)
-    near = dataclasses.replace(st, q_home=tuple(np.asarray(st.q_home) + [0.2, 0, 0, 0, 0, 0]))
+    near = dataclasses.replace(st, q_home=tuple(np.asarray(st.q_home) + np.array([0.2, 0, 0, 0, 0, 0])))
     assert check_home(link, near).status == "warn"
     wrong = dataclasses.replace(st, wiring=dataclasses.replace(st.wiring, output=(st.wiring.output + 3) % 8))
     suction = check_suction(link, wrong)
