@@ -28,6 +28,11 @@ def error_line(capsys) -> str:
      "loopback only: give --host ADDR"),
     (["ros-station", "--host", "lab-pc"], "host 'lab-pc' is invalid: expected this machine's IP address"),
     (["ros-env", "--master", "http://localhost"], "ROS master URI 'http://localhost' is invalid"),
+    (["ros-station", "--program-stop-at", "3"], "--program-stop-at needs --driver ur"),
+    (["ros-station", "--driver", "ur", "--program-stop-at", "5", "--program-resume-at", "2"],
+     "--program-resume-at 2 needs an earlier --program-stop-at (got 5)"),
+    (["ros2-station", "--driver", "ur", "--program-resume-at", "3"],
+     "--program-resume-at 3 needs an earlier --program-stop-at (got none)"),
 ])
 def test_bad_arguments_exit_2_with_one_line(argv, message, capsys, monkeypatch):
     monkeypatch.setattr("sys.stdin.isatty", lambda: False)

@@ -14,6 +14,7 @@ feedback``) and ``A`` itself (``goal``, ``result``, ``feedback``, ``send_goal_se
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 from rosbags.interfaces import Nodetype
@@ -54,7 +55,7 @@ def _service(full: str, request: tuple[Any, Any], response: tuple[Any, Any]) -> 
 
 def srv_types(text: str, full: str) -> dict[str, Any]:
     """The types rosidl makes of a ``.srv`` text (``full`` = ``pkg/srv/Name``)."""
-    request, response = text.split("\n---\n")
+    request, response = re.split(r"(?:^|\n)---\n", text, maxsplit=1)  # an empty request: the text starts with ---
     return _service(full, _parse(request, f"{full}_Request"), _parse(response, f"{full}_Response"))
 
 

@@ -16,6 +16,9 @@ every check of that client passed, 1 otherwise:
   waypoint, a single point whose time is the ``movej``'s duration, waiting for each result.
 - ``program``: the External Control program stopped mid-goal and started again: the goal preempted, the latched
   ``robot_program_running``, a goal rejected meanwhile (INVALID_GOAL, no error string), one after it runs again.
+- ``controllers``: ``controller_manager``'s list, load and switch and the dashboard's stop, play and
+  program_running, with the classes :func:`ur3hanoi.interface.ros1.ur_packages.write_ur_packages` writes (the
+  folder on ``PYTHONPATH``); leaves the scaled controller stopped for UR's ``test_move`` to switch back.
 - ``set-io``: ``set_io`` called with the current Noetic ``ur_msgs/SetIO`` text, with ur_msgs 1.3.x's, and with
   ``md5sum *``; each must switch the output seen in ``io_states``.
 """
@@ -210,9 +213,55 @@ def program() -> dict[str, Any]:
     return seen
 
 
+def controllers() -> dict[str, Any]:
+    """The controller manager and the dashboard as UR's ``test_move`` and ``integration_test.py`` call them, with the
+    classes ``write_ur_packages`` generates (on ``PYTHONPATH``): list, load, switch; stop and play the program.
+    Leaves ``pos_joint_traj_controller`` running and the scaled one stopped, for ``test_move`` to switch back."""
+    rospy = import_rospy()
+    from controller_manager_msgs.srv import ListControllers, LoadController, SwitchController, SwitchControllerRequest
+    from std_srvs.srv import Trigger
+    from ur_dashboard_msgs.srv import IsProgramRunning
+
+    rospy.init_node("ur_driver_controllers_client", anonymous=True, argv=[sys.argv[0]], disable_signals=True)
+    cm, dash = "/controller_manager/", "/ur_hardware_interface/dashboard/"
+    for name in ("list_controllers", "load_controller", "switch_controller"):
+        rospy.wait_for_service(cm + name, 30)
+    listing, load = rospy.ServiceProxy(cm + "list_controllers", ListControllers), \
+        rospy.ServiceProxy(cm + "load_controller", LoadController)
+    switch = rospy.ServiceProxy(cm + "switch_controller", SwitchController)
+    play, stop = rospy.ServiceProxy(dash + "play", Trigger), rospy.ServiceProxy(dash + "stop", Trigger)
+    running = rospy.ServiceProxy(dash + "program_running", IsProgramRunning)
+    strict, best = SwitchControllerRequest.STRICT, SwitchControllerRequest.BEST_EFFORT
+
+    def states() -> dict[str, str]:
+        return {c.name: c.state for c in listing().controller}
+
+    seen: dict[str, Any] = {"initial": states()}
+    seen["load_known"] = load("vel_joint_traj_controller").ok
+    seen["load_again"] = load("vel_joint_traj_controller").ok
+    seen["load_unknown"] = load("no_such_controller").ok
+    seen["start_running_strict"] = switch(["scaled_pos_joint_traj_controller"], [], strict, False, 0.0).ok
+    seen["two_on_the_joints"] = switch(["pos_joint_traj_controller"], [], strict, False, 0.0).ok
+    r = running()
+    seen["program"] = [r.success, r.answer, r.program_running]
+    s = stop()
+    seen["stop"] = [s.success, s.message]
+    seen["after_stop"] = states()
+    seen["start_while_stopped"] = switch(["pos_joint_traj_controller"], ["scaled_pos_joint_traj_controller"], best,
+                                         False, 0.0).ok
+    p = play()
+    seen["play"] = [p.success, p.message]
+    seen["after_play"] = states()
+    seen["to_pos"] = switch(["pos_joint_traj_controller"], ["scaled_pos_joint_traj_controller"], strict, False,
+                            0.0).ok
+    seen["final"] = states()
+    seen["ok"] = seen["to_pos"] and seen["final"]["scaled_pos_joint_traj_controller"] == "stopped"
+    return seen
+
+
 if __name__ == "__main__":
     run = {"integration": integration, "moveit": moveit, "bridge": bridge, "set-io": set_io_versions,
-           "program": program}[sys.argv[1]]
+           "program": program, "controllers": controllers}[sys.argv[1]]
     out = run()
     print(json.dumps(out))
     sys.exit(0 if out["ok"] else 1)

@@ -6,7 +6,11 @@ scaling in percent, ``set_io`` (answers once the output is set), and the traject
 
 - ``reject``: every goal is refused at send_goal (``accepted = false``, no result, no code), as
   ros2_controllers' ``validate_trajectory_msg`` does;
-- ``abort``: goals are accepted and aborted 0.3 s later with PATH_TOLERANCE_VIOLATED (-4) and the controller's text.
+- ``abort``: goals are accepted and aborted 0.3 s later with PATH_TOLERANCE_VIOLATED (-4) and the controller's text;
+- ``stopped``: the External Control program is not running (``robot_program_running`` false, transient local as the
+  driver's GPIO controller publishes it) and every goal is refused, as the inactive controller refuses it;
+- ``stop-mid``: the program runs; 0.3 s into the first goal it stops: ``robot_program_running`` turns false and the
+  goal is aborted with INVALID_GOAL and "Current goal cancelled during deactivate transition." (``on_deactivate``).
 
 At SIGINT it prints one JSON line: the goals received and the ``set_io`` calls. Usage:
 ur_driver_standin.py MODE HOME_JSON ACTION_NAME
@@ -24,8 +28,9 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64
+from std_msgs.msg import Bool, Float64
 from ur_msgs.msg import Analog, Digital, IOStates
 from ur_msgs.srv import SetIO
 
@@ -43,6 +48,9 @@ class StandIn(Node):
         self.pub_js = self.create_publisher(JointState, "/joint_states", 10)
         self.pub_io = self.create_publisher(IOStates, "/io_and_status_controller/io_states", 10)
         self.pub_scaling = self.create_publisher(Float64, "/speed_scaling_state_broadcaster/speed_scaling", 10)
+        latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.pub_program = self.create_publisher(Bool, "/io_and_status_controller/robot_program_running", latched)
+        self.pub_program.publish(Bool(data=mode != "stopped"))
         self.create_service(SetIO, "/io_and_status_controller/set_io", self.set_io, callback_group=group)
         ActionServer(self, FollowJointTrajectory, action_name, self.execute, goal_callback=self.on_goal,
                      cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group)
@@ -73,11 +81,15 @@ class StandIn(Node):
 
     def on_goal(self, _goal):
         self.goals += 1
-        return GoalResponse.REJECT if self.mode == "reject" else GoalResponse.ACCEPT
+        return GoalResponse.REJECT if self.mode in ("reject", "stopped") else GoalResponse.ACCEPT
 
     def execute(self, handle):
         time.sleep(0.3)
         handle.abort()
+        if self.mode == "stop-mid":
+            self.pub_program.publish(Bool(data=False))
+            return FollowJointTrajectory.Result(error_code=FollowJointTrajectory.Result.INVALID_GOAL,
+                                                error_string="Current goal cancelled during deactivate transition.")
         return FollowJointTrajectory.Result(error_code=FollowJointTrajectory.Result.PATH_TOLERANCE_VIOLATED,
                                             error_string="Aborted due to path tolerance violation")
 

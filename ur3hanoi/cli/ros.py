@@ -84,6 +84,7 @@ def _node(args: argparse.Namespace, report_file: Path | None) -> RosStation:
 
 
 def _run_station(args: argparse.Namespace) -> int:
+    driver.program_times(args)  # a contradiction in the program options: one line before any work
     report_file = remote.check_station_outputs(args, DEFAULT_CALIBRATION)  # before any work
     node = _node(args, report_file)
     # Standard output carries only the JSON report: whatever else writes to file descriptor 1 (rospy's info
@@ -155,6 +156,10 @@ def _add_env(sub: argparse._SubParsersAction) -> None:
         "`python lab2_exec.py --simulator True` runs against ros-station without a catkin workspace.")
     p.add_argument("--dir", metavar="DIR", help="folder to write (default: $XDG_CACHE_HOME/ur3hanoi/ros)")
     p.add_argument("--master", metavar="URI", help=_master_help())
+    p.add_argument("--driver", choices=driver.DRIVERS, default="course",
+                   help="ur: also write the official UR driver's message packages (control_msgs, "
+                        "controller_manager_msgs, cartesian_control_msgs, std_srvs, ur_dashboard_msgs), so UR's own "
+                        "clients (ur_robot_driver's scripts/test_move) run against ros-station --driver ur")
     p.set_defaults(func=_run_env)
 
 
@@ -167,7 +172,13 @@ def _run_env(args: argparse.Namespace) -> int:
     uri = args.master or master_uri_from_env()
     MasterUri.parse(uri)
     files = write_client_env(folder)
-    print(f"# ur3hanoi ros-env: wrote {len(files)} files (ur3_driver messages) to {folder}", file=sys.stderr)
+    what = "ur3_driver messages"
+    if args.driver == "ur":
+        from ur3hanoi.interface.ros1.ur_packages import write_ur_packages
+
+        files += write_ur_packages(folder)
+        what += " and the UR driver's message packages"
+    print(f"# ur3hanoi ros-env: wrote {len(files)} files ({what}) to {folder}", file=sys.stderr)
     for line in env_lines(folder, uri):
         print(line)
     return 0

@@ -93,6 +93,7 @@ def _distro(args: argparse.Namespace) -> str:
 
 
 def _run_station(args: argparse.Namespace) -> int:
+    driver.program_times(args)  # a contradiction in the program options: one line before any work
     report_file = remote.check_station_outputs(args, DEFAULT_ROS2_CALIBRATION)  # before any work
     fields = remote.station_options(args, DEFAULT_ROS2_CALIBRATION, report_file)
     if args.driver == "ur":

@@ -96,5 +96,36 @@ def test_no_driver_rejected_and_aborted_goals_end_with_one_line(tmp_path: Path) 
         assert not standin["io_calls"] or standin["io_calls"][-1] == [1, 1, 0.0]  # suction off at the end
 
 
+def test_a_stopped_program_refuses_the_solve_and_a_stop_mid_solve_ends_it_exit_3(tmp_path: Path) -> None:
+    """The stand-in driver (Jazzy) with the External Control program stopped from the start, then stopping during the
+    first goal: the client reads the latched robot_program_running over DDS."""
+    env = build_env("jazzy")
+    home = json.dumps([float(x) for x in load_station("ur3e_sim").q_home])
+    action = names_for("jazzy").follow_joint_trajectory
+    solve = f"{env.station_prefix()} {SOLVE}"
+    lines: list[str] = []
+    for mode in ("stopped", "stop-mid"):
+        lines += _with_station(env.peer_command(str(SUPPORT / "ur_driver_standin.py"), mode, home, action), solve,
+                               tmp_path, mode)
+    result = in_netns("\n".join(lines) + "\n", 120.0, REPO)
+    assert result.returncode == 0, result.stderr
+    code, _, err = _read(tmp_path, "stopped")
+    errors = [x for x in err.splitlines() if x.startswith("ur3hanoi: error:")]
+    assert code == 2 and errors == ["ur3hanoi: error: the robot program is not running (robot_program_running is "
+                                    "false on ROS_DOMAIN_ID 0 (loopback, jazzy)): the driver's trajectory controller "
+                                    "refuses every goal until it runs; start the External Control program on the "
+                                    "pendant"], err
+    standin = json.loads((tmp_path / "stopped.st.out").read_text().strip().splitlines()[-1])
+    assert standin["goals"] == 0  # refused before any goal
+    code, _, err = _read(tmp_path, "stop-mid")
+    errors = [x for x in err.splitlines() if x.startswith("ur3hanoi: error:")]
+    assert code == 3 and len(errors) == 1, err
+    assert errors[0].startswith("ur3hanoi: error: the External Control program stopped on the robot during goal 1/3")
+    assert 'INVALID_GOAL (-1) "Current goal cancelled during deactivate transition."' in errors[0]
+    assert "the arm stopped where it was, suction off" in errors[0]
+    standin = json.loads((tmp_path / "stop-mid.st.out").read_text().strip().splitlines()[-1])
+    assert standin["goals"] == 1 and standin["io_calls"][-1] == [1, 1, 0.0]  # suction off at the end
+
+
 if __name__ == "__main__":
     sys.exit(pytest.main([__file__, "-q"]))

@@ -24,7 +24,7 @@ def test_vendored_texts_are_upstreams_blobs() -> None:
     rows = _readme_rows()
     files = sorted(str(p.relative_to(MSG_TEXTS)) for p in MSG_TEXTS.rglob("*") if p.is_file()
                    and p.name != "README.md")
-    assert len(files) == 17 and sorted(path for path, _ in rows) == files
+    assert len(files) == 27 and sorted(path for path, _ in rows) == files
     for path, blob in rows:
         assert _git_blob((MSG_TEXTS / path).read_bytes()) == blob, path
 

@@ -20,7 +20,12 @@ and order are the driver's (:data:`ur3hanoi.interface.urdriver.facts.ROS1`):
   ``/ur3hanoi/program_running`` (``std_msgs/Bool``: false stops the robot program, as on the pendant: the running
   goal is preempted (``JointTrajectoryController::stopping``), new goals are rejected with INVALID_GOAL and no
   ``error_string`` (``goalCB``, ros_controllers noetic-devel ``joint_trajectory_controller_impl.h``) until it runs
-  again); the same at the times of ``--program-stop-at`` / ``--program-resume-at``.
+  again); the same at the times of ``--program-stop-at`` / ``--program-resume-at``;
+- ``/controller_manager/list_controllers``, ``load_controller`` and ``switch_controller``
+  (``controller_manager_msgs``, :class:`~ur3hanoi.interface.urdriver.controllers.Ros1ControllerManager`) and the
+  dashboard's ``/ur_hardware_interface/dashboard/play``, ``stop`` (``std_srvs/Trigger``) and ``program_running``
+  (``ur_dashboard_msgs/IsProgramRunning``), tied to the program state: UR's ``scripts/test_move`` runs against it
+  unmodified (with :func:`~ur3hanoi.interface.ros1.ur_packages.write_ur_packages`' packages on its path).
 """
 
 from __future__ import annotations
@@ -37,12 +42,16 @@ from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1, ROS1_JOIN
 from ur3hanoi.interface.urdriver.follower import Feedback, Outcome
 from ur3hanoi.interface.urdriver.goal import JointTolerance, Rejection, TrajectoryGoal, TrajectoryPoint
 from ur3hanoi.interface.urdriver.io import IoStatesMessage
+from ur3hanoi.interface.urdriver.services import ServiceCall
 from ur3hanoi.interface.urdriver.station import DriverStation, DriverStationOptions
 
 HOLD_TOPIC = "/ur3hanoi/hold_arm"
 """Fault injection: ``std_msgs/Float64`` seconds the arm is held (a person or an obstacle in the way)."""
 PROGRAM_TOPIC = "/ur3hanoi/program_running"
 """Fault injection: ``std_msgs/Bool`` false = the robot program stopped on the pendant (the controller stops)."""
+DASHBOARD = "/ur_hardware_interface/dashboard"
+"""The ROS 1 driver's dashboard services (``ur_robot_driver``'s ``dashboard_client``, in the hardware interface's
+namespace)."""
 PROGRAM_RUNNING = ROS1.program_running
 """The driver's latched ``std_msgs/Bool``: whether the robot program runs."""
 
@@ -141,6 +150,7 @@ class RosDriverServer(RosStation, DriverStation):
         rospy.Service(ROS1.set_io, set_io, self._on_set_io)
         rospy.Subscriber(HOLD_TOPIC, std_msgs.Float64, lambda msg: self.on_hold(msg.data), queue_size=10)
         rospy.Subscriber(PROGRAM_TOPIC, std_msgs.Bool, lambda msg: self.on_program(msg.data), queue_size=10)
+        self._services(rospy)
         program = rospy.Publisher(PROGRAM_RUNNING, std_msgs.Bool, queue_size=1, latch=True)
         running = [self.output.program_running]
         program.publish(std_msgs.Bool(running[0]))
@@ -162,6 +172,53 @@ class RosDriverServer(RosStation, DriverStation):
             self._goal_events(m, out.decisions, out.feedback, out.results, rospy.Time.now())
 
         return publish
+
+    def _services(self, rospy: Any) -> None:
+        """``controller_manager``'s list, load and switch, the dashboard's play, stop and program_running
+        (:mod:`~ur3hanoi.interface.urdriver.services`), with classes generated from the official texts."""
+        from ur3hanoi.interface.ros1.ur_packages import service_classes
+
+        c = service_classes()
+        cm = "controller_manager_msgs/"
+
+        def answer(call: ServiceCall) -> Any:
+            self.on_service(call)
+            return call.wait()
+
+        def listing(_req: Any) -> Any:
+            rows = answer(ServiceCall("list")) or []
+            res = c[f"{cm}HardwareInterfaceResources"]
+            states = [c[f"{cm}ControllerState"](name=n, state=s, type=t, claimed_resources=[] if not joints else [
+                res(hardware_interface=f"hardware_interface::{t.split('_')[0].capitalize()}JointInterface",
+                    resources=list(joints))]) for n, s, t, joints in rows]
+            return c[f"{cm}ListControllers"]._response_class(controller=states)
+
+        def switch(req: Any) -> Any:
+            ok = answer(ServiceCall("switch", req.start_controllers, req.stop_controllers, req.strictness))
+            return c[f"{cm}SwitchController"]._response_class(ok=bool(ok and ok[0]))
+
+        def load(req: Any) -> Any:
+            return c[f"{cm}LoadController"]._response_class(ok=bool(answer(ServiceCall("load", [req.name]))))
+
+        def trigger(kind: str) -> Any:
+            def call(_req: Any) -> Any:
+                result = answer(ServiceCall(kind)) or (False, "the station stopped")
+                return c["std_srvs/Trigger"]._response_class(success=result[0], message=result[1])
+            return call
+
+        def running(_req: Any) -> Any:
+            ok, text, value = answer(ServiceCall("running")) or (False, "the station stopped", False)
+            return c["ur_dashboard_msgs/IsProgramRunning"]._response_class(answer=text, program_running=value,
+                                                                            success=ok)
+
+        for name, srv, callback in (("list_controllers", "ListControllers", listing),
+                                    ("switch_controller", "SwitchController", switch),
+                                    ("load_controller", "LoadController", load)):
+            rospy.Service(f"/controller_manager/{name}", c[cm + srv], callback)
+        for kind, srv, callback in (("play", "std_srvs/Trigger", trigger("play")),
+                                    ("stop", "std_srvs/Trigger", trigger("stop")),
+                                    ("program_running", "ur_dashboard_msgs/IsProgramRunning", running)):
+            rospy.Service(f"{DASHBOARD}/{kind}", c[srv], callback)
 
     def _goal_events(self, m: DriverMessages, decisions: tuple[tuple[Any, Rejection | None], ...],
                      feedback: tuple[Any, Feedback] | None, results: tuple[tuple[Any, Outcome], ...],

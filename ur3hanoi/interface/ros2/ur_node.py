@@ -20,7 +20,7 @@ from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 from ur3hanoi.interface.ros2.errors import RclpyUnavailableError
 from ur3hanoi.interface.ros2.rclpy_env import import_interfaces, import_rclpy
 from ur3hanoi.interface.ros2.ur_driver import FEEDBACK_HZ, SPEED_SCALING_HZ, set_duration
-from ur3hanoi.interface.urdriver.controllers import ControllerManager
+from ur3hanoi.interface.urdriver.controllers import ControllerManager, Ros1ControllerManager
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, ROS1_JOINT_STATE_ORDER, DriverNames
 from ur3hanoi.interface.urdriver.io import IoStatesMessage
 from ur3hanoi.interface.urdriver.services import ServiceCall, controller_rows
@@ -38,7 +38,7 @@ class Served(Protocol):
     @property
     def output(self) -> CycleOutput: ...
     @property
-    def controllers(self) -> ControllerManager | None: ...
+    def controllers(self) -> ControllerManager | Ros1ControllerManager: ...
     def goal_callback(self, request: Any, now_s: float, controller: str) -> bool: ...
     def serve(self, call: ServiceCall) -> Any: ...
     def accepted(self, handle: Any, now_s: float) -> None: ...
@@ -126,7 +126,7 @@ class DriverNode:
                 return CancelResponse.ACCEPT
 
             fjt = action.FollowJointTrajectory
-            assert station.controllers is not None
+            assert isinstance(station.controllers, ControllerManager)  # the ROS 2 station's
             self.servers = [ActionServer(node, fjt, f"/{c.name}/follow_joint_trajectory",
                                          lambda h: station.execute(h, fjt),
                                          goal_callback=lambda r, name=c.name: goal_cb(r, name),

@@ -133,8 +133,7 @@ class Ros2DriverStation(DriverStation):
         rejected as an inactive controller rejects it."""
         goal = goal_from_msg(request, now_s)
         why = check_goal(goal, self.options.profile)
-        active = self.program_running and self.controllers is not None and \
-            self.controllers.trajectory_controller() == controller
+        active = self.program_running and self.controllers.trajectory_controller() == controller
         reason = NOT_RUNNING if not active else None if why is None else why.reason
         if reason is not None:
             self.rejected_at_send_goal += 1

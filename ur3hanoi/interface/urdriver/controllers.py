@@ -150,3 +150,111 @@ class ControllerManager:
         else:
             self.active |= set(self.stopped)
             self.stopped = []
+
+
+ROS1_LOADABLE = {
+    "joint_state_controller": ("joint_state_controller/JointStateController", ""),
+    "speed_scaling_state_controller": ("scaled_controllers/SpeedScalingStateController", ""),
+    "force_torque_sensor_controller": ("force_torque_sensor_controller/ForceTorqueSensorController", ""),
+    "robot_status_controller": ("industrial_robot_status_controller/IndustrialRobotStatusController", ""),
+    "scaled_pos_joint_traj_controller": ("position_controllers/ScaledJointTrajectoryController", "position"),
+    "pos_joint_traj_controller": ("position_controllers/JointTrajectoryController", "position"),
+    "scaled_vel_joint_traj_controller": ("velocity_controllers/ScaledJointTrajectoryController", "velocity"),
+    "vel_joint_traj_controller": ("velocity_controllers/JointTrajectoryController", "velocity"),
+    "joint_group_vel_controller": ("velocity_controllers/JointGroupVelocityController", "velocity"),
+    "forward_joint_traj_controller": ("pass_through_controllers/JointTrajectoryController", "forward"),
+    "forward_cartesian_traj_controller": ("pass_through_controllers/CartesianTrajectoryController", "forward"),
+    "twist_controller": ("ros_controllers_cartesian/TwistController", "velocity"),
+    "pose_based_cartesian_traj_controller": ("pose_controllers/CartesianTrajectoryController", "pose"),
+    "joint_based_cartesian_traj_controller": ("position_controllers/CartesianTrajectoryController", "position"),
+}
+"""ROS 1: what ``ur3_controllers.yaml`` (URD1 @ 66510fd) configures: name -> (type, the joints' interface it claims;
+empty: none)."""
+
+
+class Ros1ControllerManager:
+    """ROS 1's ``controller_manager`` (ros_control noetic-devel ``controller_manager.cpp``: ``switchController``,
+    ``loadController``) with ``ur3_bringup.launch``'s controllers (URD1 @ 66510fd: running
+    ``joint_state_controller scaled_pos_joint_traj_controller speed_scaling_state_controller
+    force_torque_sensor_controller``, loaded stopped ``pos_joint_traj_controller joint_group_vel_controller``), UR's
+    hardware interface (``prepareSwitch``: no controller that claims joints starts while the robot program is
+    stopped) and its ``controller_stopper`` (consistent: ``joint_state_controller speed_scaling_state_controller
+    force_torque_sensor_controller robot_status_controller``). The answers carry only ``ok``; the reasons go to the
+    log (:attr:`last_error`), as the ROS 1 manager's ``ROS_ERROR``."""
+
+    consistent = ("joint_state_controller", "speed_scaling_state_controller", "force_torque_sensor_controller",
+                  "robot_status_controller")
+
+    def __init__(self) -> None:
+        running = ("joint_state_controller", "scaled_pos_joint_traj_controller", "speed_scaling_state_controller",
+                   "force_torque_sensor_controller")
+        self.states = {n: "running" for n in running} | {n: "stopped" for n in ("pos_joint_traj_controller",
+                                                                               "joint_group_vel_controller")}
+        self.stopped: list[str] = []
+        self.last_error = ""
+
+    def trajectory_controller(self) -> str | None:
+        """The stand-in serves the scaled position controller's action only: that one, when it runs."""
+        return "scaled_pos_joint_traj_controller" if self.states.get("scaled_pos_joint_traj_controller") == \
+            "running" else None
+
+    def listing(self) -> list[tuple[str, str, str, tuple[str, ...]]]:
+        """``list_controllers``: (name, state, type, claimed joints) of every loaded controller."""
+        return [(n, s, ROS1_LOADABLE[n][0], CONTROLLER_JOINTS if ROS1_LOADABLE[n][1] else ())
+                for n, s in self.states.items()]
+
+    def load(self, name: str) -> bool:
+        """``load_controller``."""
+        if name in self.states:
+            self.last_error = f"A controller named '{name}' was already loaded inside the controller manager"
+        elif name not in ROS1_LOADABLE:
+            self.last_error = f"Could not load controller '{name}' because the type was not specified. Did you " \
+                              "load the controller configuration on the parameter server (namespace: " \
+                              f"'/{name}')?"
+        else:
+            self.states[name] = "initialized"
+            return True
+        return False
+
+    def switch(self, start: Sequence[str], stop: Sequence[str], strictness: int, program_running: bool) -> bool:
+        """``switch_controller``: ``ok``; nothing changes unless it is true."""
+        strict = strictness == STRICT
+        lists = {"start": list(dict.fromkeys(start)), "stop": list(dict.fromkeys(stop))}
+        for action, names in lists.items():
+            for name in list(names):
+                running = self.states.get(name) == "running"
+                why = (f"Could not {action} controller with name '{name}' because no controller with this name "
+                       "exists" if name not in self.states else
+                       f"Could not stop controller '{name}' since it is not running" if action == "stop" and not running
+                       else f"Could not start controller '{name}' since it is already running"
+                       if action == "start" and running and name not in lists["stop"] else "")
+                if why:
+                    self.last_error = why
+                    if strict:
+                        return False
+                    names.remove(name)
+        after = {n for n, s in self.states.items() if s == "running"} - set(lists["stop"]) | set(lists["start"])
+        if sum(1 for n in after if ROS1_LOADABLE[n][1]) > 1:
+            self.last_error = "Could not switch controllers, due to resource conflict"
+            return False
+        claiming = [n for n in lists["start"] if ROS1_LOADABLE[n][1]]
+        if claiming and not program_running:
+            self.last_error = "Robot control is currently inactive. Starting controllers that claim resources is " \
+                              f"currently not possible. Not starting controller '{claiming[0]}'"
+            return False
+        for n in lists["stop"]:
+            self.states[n] = "stopped"
+        for n in lists["start"]:
+            self.states[n] = "running"
+        return True
+
+    def program(self, running: bool) -> None:
+        """The ``controller_stopper``: stop the non-consistent running controllers, or start them again."""
+        if not running:
+            self.stopped = [n for n, s in self.states.items() if s == "running" and n not in self.consistent]
+            for n in self.stopped:
+                self.states[n] = "stopped"
+        else:
+            for n in self.stopped:
+                self.states[n] = "running"
+            self.stopped = []

@@ -48,6 +48,9 @@ class ControllerProfile:
             by default): a new trajectory starts from the *measured* state at its first sample (no point is
             dropped, a point at ``time_from_start`` 0 is commanded at once), and an abort or a cancel holds the
             measured position (``set_hold_position``); False (ROS 1): from the desired state, past points dropped.
+            Kilted and later run ros2_controllers' own JTC with the scaling built in (UR's kilted scaled controller
+            only renames a parameter; ros2_controllers kilted ``joint_trajectory_controller.cpp`` lines 305-322,
+            1291, 1506): the same rules and texts, so one flag serves Humble to Lyrical.
         deactivated_text: the ``error_string`` of the goal that runs when the controller is stopped because the
             robot program stopped: ROS 2 aborts it (``on_deactivate``, ros2_controllers jazzy
             ``joint_trajectory_controller.cpp`` @ ed360c9 lines 1255-1267, humble @ ad559d9 lines 1055-1067); empty:

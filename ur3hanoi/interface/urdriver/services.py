@@ -20,7 +20,7 @@ import threading
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
-from ur3hanoi.interface.urdriver.controllers import Controller
+from ur3hanoi.interface.urdriver.controllers import Controller, Ros1ControllerManager
 
 if TYPE_CHECKING:
     from ur3hanoi.interface.urdriver.station import DriverStation
@@ -30,8 +30,8 @@ WAIT_S = 2.0
 
 
 class ServiceCall:
-    """One call: ``kind`` (``list``, ``switch``, ``play``, ``stop``, ``running``) and its arguments; the answer
-    once :meth:`answer` ran."""
+    """One call: ``kind`` (``list``, ``switch``, ``load`` (ROS 1, the name in ``activate``), ``play``, ``stop``,
+    ``running``) and its arguments; the answer once :meth:`answer` ran."""
 
     def __init__(self, kind: str, activate: Sequence[str] = (), deactivate: Sequence[str] = (),
                  strictness: int = 0) -> None:
@@ -50,11 +50,14 @@ class ServiceCall:
     def _answer(self, station: DriverStation) -> Any:
         cm, running = station.controllers, station.program_running
         if self.kind == "list":
-            return [] if cm is None else cm.listing()
+            return cm.listing()
+        if self.kind == "load":
+            return isinstance(cm, Ros1ControllerManager) and cm.load(self.activate[0])
         if self.kind == "switch":
-            if cm is None:
-                return False, "no controller manager"
-            ok, message = cm.switch(self.activate, self.deactivate, self.strictness)
+            if isinstance(cm, Ros1ControllerManager):
+                ok, message = cm.switch(self.activate, self.deactivate, self.strictness, running), cm.last_error
+            else:
+                ok, message = cm.switch(self.activate, self.deactivate, self.strictness)
             station.sync_controllers()
             return ok, message
         if self.kind == "play":

@@ -22,11 +22,11 @@ from __future__ import annotations
 import time
 from collections.abc import Hashable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 from ur3hanoi.arrays import FloatArray
 from ur3hanoi.interface.common.station import ServerCore, ServerOptions
-from ur3hanoi.interface.urdriver.controllers import ControllerManager
+from ur3hanoi.interface.urdriver.controllers import ControllerManager, Ros1ControllerManager
 from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS
 from ur3hanoi.interface.urdriver.follower import Feedback, Outcome, TrajectoryFollower
 from ur3hanoi.interface.urdriver.goal import Rejection, TrajectoryGoal
@@ -35,7 +35,6 @@ from ur3hanoi.interface.urdriver.profile import ROS1_SCALED, ControllerProfile
 from ur3hanoi.interface.urdriver.records import DriverRecords
 
 if TYPE_CHECKING:
-    from ur3hanoi.interface.urdriver.services import ServiceCall
     from ur3hanoi.sim.config import SimConfig
     from ur3hanoi.sim.servo_world import ServoWorld
 
@@ -50,8 +49,8 @@ class DriverStationOptions(ServerOptions):
         program_stop_at_s, program_resume_at_s: fault injection: the External Control program stops (as when the
             pendant's stop button is pressed) and starts again at these world times [s] (None: never).
         initial_controller: ROS 2: the controller manager's initial motion controller
-            (:class:`~ur3hanoi.interface.urdriver.controllers.ControllerManager`); None (ROS 1): no controller
-            manager, the trajectory controller runs whenever the program does.
+            (:class:`~ur3hanoi.interface.urdriver.controllers.ControllerManager`); None: ROS 1's controller manager
+            (:class:`~ur3hanoi.interface.urdriver.controllers.Ros1ControllerManager`).
     """
 
     rate_hz: float | None = None
@@ -90,6 +89,12 @@ class CycleOutput:
     program_running: bool = True
 
 
+class StationCall(Protocol):
+    """A call answered in the control thread (:class:`ur3hanoi.interface.urdriver.services.ServiceCall`)."""
+
+    def answer(self, station: DriverStation) -> None: ...
+
+
 class DriverStation(ServerCore["ServoWorld"]):
     """The simulated UR robot behind the official driver's interface (see the module docstring)."""
 
@@ -110,8 +115,10 @@ class DriverStation(ServerCore["ServoWorld"]):
         self._effort_ids = w.servo.act_ids
         self._program_done: set[float] = set()
         self.program_running = True
-        self.controllers = None if options.initial_controller is None else ControllerManager(options.initial_controller)
-        self._owner = None if self.controllers is None else self.controllers.trajectory_controller()
+        self.controllers: ControllerManager | Ros1ControllerManager = \
+            Ros1ControllerManager() if options.initial_controller is None else \
+            ControllerManager(options.initial_controller)
+        self._owner = self.controllers.trajectory_controller()
         if options.program_stop_at_s is not None and options.program_stop_at_s <= 0.0:
             self._scheduled_program()  # stopped from the start: the first output says so
         self.output = self._output((), None, ())
@@ -175,15 +182,15 @@ class DriverStation(ServerCore["ServoWorld"]):
         else:
             super()._handle(kind, payload)
 
-    def on_service(self, request: ServiceCall) -> None:
+    def on_service(self, request: StationCall) -> None:
         """A ``controller_manager`` or dashboard call (any thread): answered in the next control cycle."""
         self.inbox.offer("service", request)
 
     def sync_controllers(self) -> None:
         """The follower runs while the program does and (ROS 2) a trajectory controller is active; a switch to
         another one ends the running goal as a deactivation does."""
-        owner = None if self.controllers is None else self.controllers.trajectory_controller()
-        running = self.program_running and (self.controllers is None or owner is not None)
+        owner = self.controllers.trajectory_controller()
+        running = self.program_running and owner is not None
         if owner != self._owner and self.follower.running:
             self.follower.set_running(False)
         self._owner = owner
@@ -195,8 +202,7 @@ class DriverStation(ServerCore["ServoWorld"]):
         if running == self.program_running:
             return
         self.program_running = running
-        if self.controllers is not None:
-            self.controllers.program(running)
+        self.controllers.program(running)
         self.sync_controllers()
         self.records.program_changed(self.world.time, running)
         self.log.log(self.TOPIC_LOG["program"], "warn", "the External Control program runs again" if running else
@@ -261,5 +267,11 @@ class DriverStation(ServerCore["ServoWorld"]):
 
     def _report_final(self) -> dict[str, Any]:
         return {"goal_active": self.follower.active is not None, "program_running": self.program_running,
-                **({} if self.controllers is None else {"active_controllers": sorted(self.controllers.active)}),
+                "controllers": self._controller_states(),
                 "speed_scaling": round(self.world.speed_scaling, 6)}
+
+    def _controller_states(self) -> dict[str, str]:
+        cm = self.controllers
+        if isinstance(cm, Ros1ControllerManager):
+            return dict(cm.states)
+        return {c.name: state for c, state in cm.listing()}
