@@ -62,6 +62,7 @@ def test_a_ready_cell_passes_with_a_slider_warning_and_a_suction_round_trip(cell
         "suction": "ok"}
     assert checks["speed"]["value"] == pytest.approx(0.5, abs=1e-6) and "above 25 %" in checks["speed"]["line"]
     assert 90.0 < checks["model"]["value"] < 160.0  # the CB3's 125 Hz
+    assert checks["controller"]["value"] == "running"  # ros_control's list_controllers
     assert "DO0=1 DI0=0" in checks["suction"]["line"] and "DO0=0 DI0=0" in checks["suction"]["line"]
     assert len(err.strip().splitlines()) == 8 and err.strip().endswith("ready for the first move (read the warnings)")
 
@@ -90,7 +91,8 @@ def test_a_stopped_program_fails_program_and_controller(cell):
         subprocess.run([sys.executable, "-c", PROGRAM, "run"], env=env, timeout=30)
     assert code == 2
     assert checks["program"]["status"] == "fail" and "External Control program is stopped" in checks["program"]["line"]
-    assert checks["controller"]["status"] == "fail"
+    assert checks["controller"]["status"] == "fail" and checks["controller"]["value"] == "stopped"
+    assert "scaled_pos_joint_traj_controller is stopped (controller_manager)" in checks["controller"]["line"]
     assert "2 check(s) failed (program, controller)" in err
 
 

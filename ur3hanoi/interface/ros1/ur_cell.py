@@ -15,6 +15,9 @@ from ur3hanoi.interface.ros1.ur_client import RosDriverTransport
 from ur3hanoi.interface.urdriver.cell import JointHistory
 from ur3hanoi.interface.urdriver.facts import ROS1
 
+LIST_CONTROLLERS = "/controller_manager/list_controllers"
+"""``controller_manager_msgs/ListControllers``: every controller with its state (ros_control: ``running``)."""
+
 
 class _OldGoalFilter(logging.Filter):
     """Drops actionlib's "on a goal handle that we're not tracking": ``SimpleActionClient`` tracks only the newest
@@ -41,8 +44,23 @@ class RosCellLink(RosDriverTransport):
         return self.latest().program_running
 
     def controller_state(self) -> str | None:
-        """None: the ROS 1 driver's controller manager is not asked (its message package is not at hand)."""
-        return None
+        """The trajectory controller's state in ``/controller_manager/list_controllers`` (``running``, ``stopped``,
+        ``initialized``, ``not loaded``), or None when no controller manager answers within 1 s."""
+        from ur3hanoi.interface.ros1.ur_packages import service_classes
+
+        rospy = self._rospy
+        cls = service_classes()["controller_manager_msgs/ListControllers"]
+        proxy = rospy.ServiceProxy(LIST_CONTROLLERS, cls)
+        try:
+            proxy.wait_for_service(1.0)
+            answer = proxy()
+        except (rospy.ROSException, rospy.ServiceException):
+            return None
+        finally:
+            proxy.close()
+        wanted = self.action.strip("/").split("/")[0]
+        states = {str(c.name): str(c.state) for c in answer.controller}
+        return states.get(wanted, "not loaded")
 
     def simulated(self) -> bool:
         from ur3hanoi.interface.ros1.master import node_registered

@@ -4,9 +4,9 @@ Each check gives one :class:`Check` (``ok``, ``warn``, ``fail`` or ``skip``) and
 
 - ``driver``: the driver answers (joint states, ``io_states``, the trajectory action, ``set_io``: the link's connect);
 - ``program``: the External Control program runs (the driver's latched ``robot_program_running``);
-- ``controller``: the scaled trajectory controller can execute: ``active`` in the controller manager's list where
-  the driver offers one (ROS 2), else its action server answers; and the program runs (the drivers stop it with the
-  program);
+- ``controller``: the scaled trajectory controller can execute: ``running`` (ROS 1) or ``active`` (ROS 2) in the
+  controller manager's list where the driver answers ``list_controllers``, else its action server answers; and the
+  program runs (the drivers' ``controller_stopper`` stops it with the program);
 - ``speed``: the speed slider (the driver's speed scaling with the arm at rest): above :data:`FIRST_RUN_SLIDER` a
   warning for a first run, 0 (paused) a failure;
 - ``model``: the arm against the calibration's robot, by what the driver shows of it: its control rate (a CB3 UR3
@@ -43,6 +43,8 @@ RATE_WINDOW_S = 1.0
 """[s] how long the joint states are counted to tell the controller's rate."""
 E_SERIES_ABOVE_HZ = 250.0
 """[Hz] a joint-state rate above this is an e-Series controller (500 Hz), below a CB3 (125 Hz): the geometric mean."""
+ACTIVE = ("active", "running")
+"""A controller that executes: ROS 2's ``active``, ROS 1 ros_control's ``running``."""
 PROGRAM_WAIT_S = 1.0
 """[s] how long the latched program state is waited for."""
 SUCTION_SETTLE_S = 1.0
@@ -86,7 +88,7 @@ def check_program(link: CellLink) -> Check:
 def check_controller(link: CellLink, program: Check) -> Check:
     state = link.controller_state()
     name = link_controller(link)
-    if state is not None and state != "active":
+    if state is not None and state not in ACTIVE:
         return Check("controller", "fail", f"{name} is {state} (controller_manager): "
                                            + ("the driver stops it with the program: start the program"
                                               if program.status == "fail" else "activate it (switch_controller)"),
@@ -94,7 +96,7 @@ def check_controller(link: CellLink, program: Check) -> Check:
     if program.status == "fail":
         return Check("controller", "fail", f"{name} does not execute while the program is stopped (its goals are "
                                            "refused)", state or False)
-    how = "active (controller_manager)" if state == "active" else "its action server answers"
+    how = f"{state} (controller_manager)" if state in ACTIVE else "its action server answers"
     return Check("controller", "ok", f"{name}: {how}" +
                  ("" if program.status == "ok" else " (whether the program runs is not known)"), state or True)
 
