@@ -100,13 +100,13 @@ def _course_checks(args: argparse.Namespace, station: Station) -> list[Check]:
 def _course_home(samples: list[tuple[float, Any]], station: Station) -> Check:
     import numpy as np
 
-    from ur3hanoi.interface.urdriver.check import HOME_FAR_RAD, HOME_OK_RAD, Check
+    from ur3hanoi.interface.urdriver.check import HOME_FAR_RAD, HOME_OK_RAD, Check, Status
 
     if not samples:
         return Check("home", "fail", "no position")
     far = float(np.max(np.abs(samples[-1][1] - station.q_home_array)))
-    status = "ok" if far <= HOME_OK_RAD else "warn" if far <= HOME_FAR_RAD else "fail"
-    return Check("home", status, f"{far:.3f} rad from home (largest joint)", round(far, 4))  # type: ignore[arg-type]
+    status: Status = "ok" if far <= HOME_OK_RAD else "warn" if far <= HOME_FAR_RAD else "fail"
+    return Check("home", status, f"{far:.3f} rad from home (largest joint)", round(far, 4))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -118,11 +118,7 @@ def run(args: argparse.Namespace) -> int:
     if args.ros_distro is not None and (args.driver != "ur" or args.via != "ros2"):
         raise UsageError("--ros-distro is only used with --via ros2 --driver ur")
     station = load_station(args.calibration)
-    if args.driver == "course":
-        args.record_now = None
-        checks = _course_checks(args, station)
-    else:
-        checks = _ur_checks(args, station)
+    checks = _course_checks(args, station) if args.driver == "course" else _ur_checks(args, station)
     failed = [c.name for c in checks if c.status == "fail"]
     lines = "\n".join(f"{c.status:<5} {c.name:<10} {c.line}" for c in checks)
     verdict = (f"check-arm: {len(failed)} check(s) failed ({', '.join(failed)}): fix them before the first move"

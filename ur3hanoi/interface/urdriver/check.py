@@ -207,6 +207,20 @@ def check_cell(link: CellLink, station: Station, label: str, suction: bool) -> l
     return checks
 
 
-__all__ = ["E_SERIES_ABOVE_HZ", "FIRST_RUN_SLIDER", "HOME_FAR_RAD", "HOME_OK_RAD", "Check", "check_cell",
-           "check_controller", "check_home", "check_model", "check_program", "check_speed", "check_suction",
-           "joint_rate_hz"]
+__all__ = [
+    "ACTIVE",
+    "E_SERIES_ABOVE_HZ",
+    "FIRST_RUN_SLIDER",
+    "HOME_FAR_RAD",
+    "HOME_OK_RAD",
+    "Check",
+    "Status",
+    "check_cell",
+    "check_controller",
+    "check_home",
+    "check_model",
+    "check_program",
+    "check_speed",
+    "check_suction",
+    "joint_rate_hz",
+]
