@@ -23,9 +23,12 @@ from typing import Protocol
 from ur3hanoi.errors import DriverError
 from ur3hanoi.station.calibration import Station
 from ur3hanoi.teach.driver import Driver, DriverNames
+from ur3hanoi.teach.jog import JogTarget
 from ur3hanoi.teach.session import ARRIVAL_MARGIN_S, Teacher
 from ur3hanoi.teach.taught_file import TaughtFile
 
+GOAL_WAIT_S = 60.0
+"""[s] the longest a jog goal without a result is waited for (a 20 mm step takes about 1 s at a slider of 100 %)."""
 SUCTION_KEY = "v"
 """The key that switches the suction (vacuum) on or off."""
 
@@ -81,6 +84,7 @@ class UrTeacher(Teacher):
                  start: int, accept: Collection[tuple[int, int]] = ()) -> None:
         super().__init__(base, base_label, taught, driver, names, start, accept)
         self.suction_on = False
+        self.move_started = 0.0  # [s, monotonic] when the running jog goal was sent
         self.extra_help = (f"{SUCTION_KEY} suction on/off through set_io on DO{base.wiring.output}, read back from "
                            f"io_states (DI{base.wiring.switch_input} = 1: a block is held); jogging needs the External "
                            "Control program, recording does not",)
@@ -92,7 +96,7 @@ class UrTeacher(Teacher):
         return super()._motion_allowed()
 
     def tick(self) -> list[str]:
-        if self.move is not None and self.driver.goal_running():
+        if self.move is not None and self.driver.goal_running() and time.monotonic() < self.move_started + GOAL_WAIT_S:
             # The goal's own time runs with the pendant's slider: wait for its result, not for the jog caps' time.
             self.move = dataclasses.replace(self.move, deadline=time.monotonic() + ARRIVAL_MARGIN_S)
         lines = super().tick()
@@ -101,6 +105,10 @@ class UrTeacher(Teacher):
             what, self.move = self.move.what, None
             lines.append(f"{what}: {problem}")
         return lines
+
+    def _send(self, target: JogTarget, what: str) -> list[str]:
+        self.move_started = time.monotonic()
+        return super()._send(target, what)
 
     def other_key(self, ch: str) -> list[str] | None:
         if ch != SUCTION_KEY:
@@ -113,4 +121,4 @@ class UrTeacher(Teacher):
         return [said]
 
 
-__all__ = ["SUCTION_KEY", "UrDriver", "UrTeacher", "program_line", "ur_names"]
+__all__ = ["GOAL_WAIT_S", "SUCTION_KEY", "UrDriver", "UrTeacher", "program_line", "ur_names"]
