@@ -150,7 +150,7 @@ def ros2_run(tmp: Path, label: str, prefix: str, station: str, solve: str, calib
     script = f"""{PRELUDE}
 {ur3hanoi} ros2-station {station} --report {tmp}/report.json > {tmp}/st.out 2> {tmp}/st.err &
 ST=$!
-wait_ready {tmp}/st.out || exit 90
+wait_ready {tmp}/st.err || exit 90
 {ur3hanoi} ros2-solve --start 1 --end 3 --json {solve} > {tmp}/solve.out 2> {tmp}/solve.err
 echo $? > {tmp}/solve.code
 kill -INT $ST; wait $ST

@@ -12,9 +12,11 @@ import numpy as np
 import pytest
 
 from tests.support import gross_matrix as gm
+from tests.support import recorded_tables as rt
 from ur3hanoi.calibrate.consensus import AMBIGUOUS_SCORE, consensus
 from ur3hanoi.calibrate.grid_fit import measure
 from ur3hanoi.station.calibration import Station, load_station
+from ur3hanoi.station.grid import contact_point_world
 from ur3hanoi.tables.ik_table import generate_table
 from ur3hanoi.teach.jog import Jogger
 
@@ -40,8 +42,10 @@ def test_one_gross_error_is_named_and_left_out_or_nothing_is_written(name: str) 
     error per slot."""
     counts = check_cases(list(gm.fast_cases(TRUTHS[name])))
     # In the minimal file every wrong point is its tower's only contact: named and nothing written, or too small
-    # to see (a joint off by 2 deg moves the cup a few mm).
-    assert counts["refused"] >= 12 and counts["named"] >= 1, counts
+    # to see (a joint off by 2 deg moves the cup a few mm), or moving its tower along the table only (a joint-1
+    # offset; on the flat lab_sim a slot one height off): written, and said (issue 37).
+    assert counts["refused"] + counts["undecided"] + counts["said"] >= 12 and counts["named"] >= 1, counts
+    assert counts["said"] <= 8, counts  # never most of them
 
 
 @pytest.mark.slow
@@ -49,7 +53,11 @@ def test_one_gross_error_is_named_and_left_out_or_nothing_is_written(name: str) 
 def test_the_whole_matrix(name: str) -> None:
     """Every file (3 to 9 points), every slot, every error."""
     counts = check_cases(list(gm.cases(TRUTHS[name])))
-    assert counts["named"] + counts["refused"] + counts["undecided"] >= 0.9 * sum(counts.values()), counts
+    # Issue 37: an error that moves a tower taught once along the table only is written and said (on the flat
+    # lab_sim a slot one height off is such a move too): never more than a tenth of the cases.
+    total = sum(counts.values())
+    assert counts["named"] + counts["refused"] + counts["undecided"] + counts["said"] >= 0.9 * total, counts
+    assert counts["said"] <= 0.11 * total, counts
 
 
 def test_the_matrix_is_the_issue_s_cases() -> None:
@@ -92,16 +100,32 @@ def test_hand_errors_of_1_mm_are_never_named(hidden: Station) -> None:
 
 
 @pytest.mark.parametrize("bad", [0, 1, 2])
-def test_a_pose_15_mm_off_is_named_whichever_it_is(hidden: Station, bad: int) -> None:
+def test_a_pose_15_mm_off_the_table_s_level_is_named_whichever_it_is(hidden: Station, bad: int) -> None:
     base, rng = load_station("lab_real"), np.random.default_rng(bad)
     first = 0
     for _ in range(20):
         off = {i: 0.6 * unit(rng) for i in range(3)}
-        off[bad] = off[bad] + 15.0 * unit(rng)
+        off[bad] = off[bad] + np.array([*(5.0 * unit(rng)[:2]), float(rng.choice([-15.0, 15.0]))])
         c = consensus(base, FIRST, measure(base, taught(hidden, FIRST, off)), np.ones(3, dtype=bool))
         assert c.kind in ("named", "undecided") and bad in c.wrong and c.alone  # each is its tower's only contact
         first += c.wrong[0] == bad
     assert first == 20  # named first every time (alone, or with a rival the points cannot rule out)
+
+
+@pytest.mark.parametrize("bad", [0, 1, 2])
+def test_a_tower_taught_once_may_stand_anywhere_on_the_table(hidden: Station, bad: int) -> None:
+    """Issue 37: nothing but the base's layout could say a tower taught once stands 15-110 mm along the table from
+    where that layout puts it, and real towers do: the points agree."""
+    base, rng = load_station("lab_real"), np.random.default_rng(10 + bad)
+    for mm in (15.0, 50.0, 110.0):
+        a = float(rng.uniform(-np.pi, np.pi))
+        qs = [rt.pose_q(hidden, contact_point_world(hidden, t, h) + (mm * 1e-3 * np.array([np.cos(a), np.sin(a), 0.0])
+                                                                    if i == bad else 0.0), rt.R_tcp(hidden.tool_yaw))
+              for i, (t, h, _) in enumerate(FIRST)]
+        c = consensus(base, FIRST, measure(base, qs), np.ones(3, dtype=bool))
+        assert c.kind == "agree", (mm, c.kind, [ch for ch in c.whole.checks if ch.over])
+        # Judged by the table's level alone (the hidden towers stand up to 1.5 mm from their layout).
+        assert c.whole.by[bad] == "level" and c.whole.off_mm[bad] == pytest.approx(0.0, abs=2.0)
 
 
 def test_two_points_nothing_tells_apart_are_both_named(hidden: Station) -> None:
@@ -111,20 +135,45 @@ def test_two_points_nothing_tells_apart_are_both_named(hidden: Station) -> None:
     c = consensus(base, slots, measure(base, qs), np.ones(6, dtype=bool))
     assert c.kind == "undecided" and sorted(c.wrong) == [1, 4]
     assert abs(c.tried[1].score - c.tried[4].score) < AMBIGUOUS_SCORE
-    # The evidence decides once one of them is far from where the layout puts tower 2.
+    # Sideways, nothing but the layout could tell them apart, however far: still both named.
     qs = taught(hidden, slots, {1: np.array([5.0, 0.0, 0.0]), 4: np.array([-16.0, 0.0, 0.0])})
+    c = consensus(base, slots, measure(base, qs), np.ones(6, dtype=bool))
+    assert c.kind == "undecided" and sorted(c.wrong) == [1, 4]
+    # The table's level decides once one of them is off in height: left alone, it would stand 16 mm low.
+    qs = taught(hidden, slots, {1: np.array([5.0, 0.0, 0.0]), 4: np.array([0.0, 0.0, -16.0])})
     c = consensus(base, slots, measure(base, qs), np.ones(6, dtype=bool))
     assert c.kind == "named" and c.wrong == (4,) and not c.alone
 
 
 def test_a_point_vouched_for_is_never_left_out_and_its_tower_not_judged(hidden: Station) -> None:
     base = load_station("lab_real")
-    qs = taught(hidden, FIRST, {1: np.array([0.0, 30.0, 0.0])})  # tower 2 really stands 30 mm along the row
+    qs = taught(hidden, FIRST, {1: np.array([0.0, 0.0, 30.0])})  # tower 2 really stands on a 30 mm plinth
     m = measure(base, qs)
     said = consensus(base, FIRST, m, np.ones(3, dtype=bool))
     assert said.kind == "named" and said.wrong == (1,) and said.alone
     vouched = consensus(base, FIRST, m, np.ones(3, dtype=bool), accepted=np.array([False, True, False]))
-    assert vouched.kind == "agree" and not any(c.what == "layout" and c.index == 1 for c in vouched.whole.checks)
+    assert vouched.kind == "agree"
+    assert not any(c.what in ("level", "lean") and c.index == 1 for c in vouched.whole.checks)
+
+
+def test_a_tower_tilted_alike_is_the_tower_s_a_single_tilted_point_is_wrong(hidden: Station) -> None:
+    """Issue 37: every contact of one tower tilted 6.5 deg is how the student held the wrist there; one contact
+    tilted 6.5 deg among its tower's others is wrong."""
+    base, q = load_station("lab_real"), generate_table(hidden).q
+    slots = [(t, h, 0) for t in range(3) for h in range(3)]
+    qs = []
+    for t, h, k in slots:
+        p = contact_point_world(hidden, t, h)
+        qs.append(rt.pose_q(hidden, p, rt.R_tcp(hidden.tool_yaw, 6.5, 0.7)) if t == 2 else q[t, h, k])
+    c = consensus(base, slots, measure(base, qs), np.ones(9, dtype=bool))
+    assert c.kind == "agree", [ch for ch in c.whole.checks if ch.over]
+    one = list(qs)
+    for i in (6, 8):
+        one[i] = q[slots[i]]  # tower 3: only its height 2 tilted
+    c = consensus(base, slots, measure(base, one), np.ones(9, dtype=bool))
+    assert c.kind == "named" and c.wrong == (7,)
+    tilt = [ch for ch in c.whole.checks if ch.what == "tilt" and ch.index == 7]
+    assert tilt and tilt[0].value == pytest.approx(6.5, abs=0.01)  # from the mean of its two mates' axes
 
 
 def test_a_tower_alone_fixing_the_step_is_checked_by_the_block_size() -> None:

@@ -160,11 +160,10 @@ def write_base(path: Path, station: Station) -> Path:
 def test_minimal_workflow_reproduces_a_random_station(real_base: Station, seed: int) -> None:
     truth = synthetic_station(np.random.default_rng(seed), real_base)
     # The base's block size is the truth's: only the grid is taken from the points. Its towers are lab_real's, far
-    # from the truth's: each point is taken on the student's word (without, nothing is written).
+    # from the truth's: the base says nothing about where towers stand (issue 37), each rests on its one pose.
     base = replace(real_base, block_size=truth.block_size, contact_depth=truth.contact_depth)
-    assert not fit_station(base, teach(truth, MINIMAL)).sound
-    fit = fit_station(base, teach(truth, MINIMAL), accept={(t, h) for t, h, _ in MINIMAL})
-    assert fit.sound and len(fit.accepted) == 3
+    fit = fit_station(base, teach(truth, MINIMAL))
+    assert fit.sound and fit.accepted == () and [(t, i) for t, i, _ in fit.single_pose] == [(0, 0), (1, 1), (2, 2)]
     assert fit.fitted_params == ("tower_origins", "tool_yaw")
     assert fit.dof == 0
     assert fit.station.height_step == pytest.approx((0.0, 0.0, truth.block_size), abs=1e-12)
@@ -521,7 +520,8 @@ def test_cli_calibrate_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
                                str(LAB_REAL), "-o", str(out), "--json"], capsys)
     assert rc == 0 and out.exists()
     doc = json.loads(stdout)
-    assert set(doc) == {"entries", "suspects", "warnings", "fit"} and doc["suspects"] == doc["warnings"] == []
+    assert set(doc) == {"entries", "suspects", "warnings", "fit", "single_pose", "notes"}
+    assert doc["suspects"] == doc["warnings"] == doc["single_pose"] == doc["notes"] == []  # every tower checked
     assert len(doc["entries"]) == 18 and doc["entries"][0]["field"] == "real_pos[0][0][0]"
     assert doc["fit"]["points_used"] == 18 and doc["fit"]["rms_mm"] < 1e-6
     assert err.startswith(f"wrote {out}: fitted ")
@@ -573,22 +573,34 @@ def test_cli_the_home_pose_as_a_tower_s_only_contact_writes_nothing(tmp_path: Pa
     assert stdout.count("suspect\n") == 1  # the named point only: the others are judged by a fit it bent
 
 
-def test_cli_a_tower_that_really_stands_elsewhere_is_accepted_on_the_student_s_word(
+def test_cli_a_tower_that_stands_elsewhere_is_written_and_the_single_pose_said(
         real_base: Station, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 37: real towers stand 12-105 mm from where the base's layout puts them. A tower taught once, 30 mm
+    along the row from there, is written where its pose puts it; the output, the JSON and the file's header say it
+    rests on one pose and which pose would check it."""
     o = list(real_base.tower_origins)
     o[1] = (o[1][0], o[1][1] + 0.030, o[1][2])  # tower 2 stands 30 mm further along the row
     moved = real_base.with_grid(o, real_base.height_step, real_base.tool_yaw)
     taught_file = write_taught(tmp_path / "t.yaml", teach(moved, (*MINIMAL, (0, 2, ON))))
     out = tmp_path / "o.yaml"
     argv = ["calibrate", "--taught", str(taught_file), "--base", "lab_real", "-o", str(out)]
-    rc, _, err = run_cli(argv, capsys)
-    assert rc == 2 and not out.exists() and "(if tower 2 really stands there, run again with --accept 2,1)" in err
-    rc, stdout, err = run_cli([*argv, "--accept", "2,1"], capsys)
-    assert rc == 0, err
-    said = [line for line in stdout.splitlines() if "on your word" in line]
-    assert said and said[0].startswith("tower 2 placed by tower 2 height 1 [points[1]] on your word (--accept 2,1): ")
-    assert f"# {said[0]}" in out.read_text()
+    rc, stdout, err = run_cli(argv, capsys)
+    assert rc == 0 and err == "", err
+    note = ("tower 2 rests on one pose, tower 2 height 1 [points[1]]: nothing checks where it stands along the table "
+            "(a joint-1 offset would move it with nothing else changed); record tower 2 height 1 above (or a second "
+            "height of tower 2) to check it")
+    said = [line for line in stdout.splitlines() if "rests on one pose" in line]
+    assert said == [note, note.replace("tower 2", "tower 3").replace("points[1]", "points[2]")]
+    assert f"# {note}\n" in out.read_text()
     np.testing.assert_allclose(load_station(out).tower_origins, moved.tower_origins, atol=1e-9)
+    rc, stdout, err = run_cli([*argv, "--json"], capsys)
+    doc = json.loads(stdout)
+    assert rc == 0 and doc["notes"] == said and [d["tower"] for d in doc["single_pose"]] == [2, 3]
+    assert doc["single_pose"][0] == {"tower": 2, "pose": "points[1]", "check_with": "tower 2 height 1 above",
+                                     "axis_from_other_towers_deg": pytest.approx(0.0, abs=1e-3)}
+    # --accept still takes a point on the student's word (never left out), and names it.
+    rc, stdout, err = run_cli([*argv, "--accept", "2,1"], capsys)
+    assert rc == 0 and "tower 2 placed by tower 2 height 1 [points[1]] on your word (--accept 2,1)\n" in stdout
     rc, _, err = run_cli([*argv, "--accept", "2,2"], capsys)
     assert rc == 2 and err.count("\n") == 1
     assert "--accept 2,2 is invalid: no contact pose is taught at tower 2 height 2" in err
@@ -601,5 +613,7 @@ def test_points_the_finer_pruning_would_leave_out_stay_when_leaving_them_out_ben
     case = next(c for c in gm.cases(t, {"random7": gm.files(t)["random7"]}) if c.wrong == 4 and c.kind == "joint")
     fit = fit_station(t.base, case.taught)
     assert all(fit.used) and gm.tower_error_mm(fit.station, t.truth) < gm.TOWER_MM
-    # Still more than 3 mm off the grid and alone to fix the approach: named first, nothing written.
-    assert fit.suspects[0].index == 4 and fit.problem.startswith("tower 3 height 1 above [points[4]] (")
+    # Still more than 3 mm off the grid and alone to fix the approach: named first; within the always-flagged 10 mm
+    # an above pose may be off its line, so written (a contact and the above pose over it, each recorded with 1-3 mm
+    # of noise, disagree by that much: issue 37).
+    assert fit.suspects[0].index == 4 and fit.sound

@@ -85,3 +85,6 @@ def test_nullable_accepts_null_or_a_valid_value() -> None:
     with pytest.raises(InputError, match=r"field 'x\[1\]\[0\]' = 2 is invalid: expected a number in \[0, 1\]"):
         validate([None, [2, 0]], spec, "f.yaml", path="x")
     assert Nullable(Number(0, 1)).expected() == "a number in [0, 1], or null"
+    # a nullable number out of range says that null is allowed too (the calibration's io.vacuum_generator_output)
+    with pytest.raises(InputError, match=r"field 'pin' = 18 is invalid: expected an integer in \[0, 17\], or null$"):
+        validate({"pin": 18}, Record({"pin": Field(Nullable(Number(0, 17, integer=True)))}), "f.yaml")

@@ -118,9 +118,10 @@ stop_background() {  # on every exit path: stop what the page started in the bac
   for pid in "${ur3hanoi_bg[@]}"; do kill -TERM "$pid" 2>/dev/null; done
 }
 trap stop_background EXIT
-wait_ready() {  # wait_ready PID OUT ERR: until the background command printed its ready line (120 s at most)
+wait_ready() {  # wait_ready PID OUT ERR: until the background command printed its ready line on stderr (120 s at
+  # most): a station's stdout is its JSON report alone
   for _ in $(seq 1 1200); do
-    grep -qs "ready" "$2" "$3" && return 0
+    grep -qs "ready" "$3" && return 0
     kill -0 "$1" 2>/dev/null || return 1
     sleep 0.1
   done

@@ -4,6 +4,10 @@ serves the course's topics to student programs. Its behaviour as ``../shared/lab
 bridge as its code behaves", read from the 2025 real-arm bridge's C++ source, MarylandRoboticsCenter/ENME480_mrc @
 202d608) describes it:
 
+- At start (``ioStartStop(1)``, lines 57-58 and 95-110 of ``ur3e_mrc_enme480_ctrl.cpp``, MarylandRoboticsCenter/
+  ENME480_mrc): ``set_io`` the tool voltage to 12 V (``FUN_SET_TOOL_VOLTAGE``, for a laser pointer), then the
+  **vacuum generator on**: digital output pin 12 (configurable output 4); both waited for. On exit (line 329,
+  ``ioStartStop(0)``): the tool voltage 0 V and pin 12 off, not waited for.
 - ``ur3e/command`` (``CommandUR3e``), queue depth 10, one command at a time: commands arriving during a move wait
   and run one after another. A ``destination`` whose length is not 6 is logged and ignored. The suction output
   (digital output 1, through ``set_io``) is switched first, only when ``io_0`` changes; then the destination (course
@@ -39,6 +43,7 @@ JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_j
           "wrist_3_joint"]
 OFFSET = [math.pi / 2, 0.0, 0.0, -math.pi / 2, 0.0, 0.0]
 SUCTION_PIN = 1
+GENERATOR_PIN = 12
 MOVE_S = 2.0
 
 
@@ -55,6 +60,10 @@ class Bridge(Node):
         others = ReentrantCallbackGroup()
         self.action = ActionClient(self, FollowJointTrajectory, action_name, callback_group=others)
         self.set_io = self.create_client(SetIO, "/io_and_status_controller/set_io", callback_group=others)
+        # As the bridge's constructor: the generator on before the course's topics exist (a student's program waits
+        # for ur3e/position)
+        self.set_io.wait_for_service(timeout_sec=30.0)
+        io_start_stop(self, True)  # "Turning ON the vacuum generator"
         self.pub_position = self.create_publisher(PositionUR3e, "ur3e/position", 10)
         self.pub_gripper = self.create_publisher(GripperInput, "ur3e/gripper_input", 10)
         self.pub_grasping = self.create_publisher(Bool, "gripper/grasping", 10)
@@ -105,6 +114,16 @@ class Bridge(Node):
             self.ready = False
 
 
+def io_start_stop(bridge, on):
+    """The bridge's ``ioStartStop``: the tool voltage (12 V / 0 V), then the vacuum generator's output; waits for
+    the answers only when switching on."""
+    for fun, pin, state in ((4, 17, 12.0 if on else 0.0), (1, GENERATOR_PIN, 1.0 if on else 0.0)):
+        future = bridge.set_io.call_async(SetIO.Request(fun=fun, pin=pin, state=state))
+        rclpy.spin_until_future_complete(bridge, future, timeout_sec=5.0 if on else 1.0)
+        if on and not (future.done() and future.result().success):
+            bridge.get_logger().error("IO Start/Stop failed")
+
+
 def main():
     rclpy.init()
     bridge = Bridge(sys.argv[1])
@@ -116,6 +135,8 @@ def main():
         pass
     finally:
         executor.shutdown()
+        if rclpy.ok():
+            io_start_stop(bridge, False)
         bridge.destroy_node()
         rclpy.try_shutdown()
 

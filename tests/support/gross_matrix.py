@@ -18,7 +18,11 @@ Each case's outcome (:func:`outcome`) is one of :data:`ALLOWED`:
 - ``undecided``: nothing written, the message names the wrong point among the ones the points cannot tell apart;
 - ``kept``: written with the wrong point in, every tower within the always-flagged 8 mm (plus the hidden towers'
   own offsets) of the truth: an error the evidence cannot see (an above pose's height is the approach itself; a
-  tower taught once may stand a few mm from the layout).
+  tower taught once may stand a few mm from the layout);
+- ``said`` (issue 37): written with the wrong point in, where it is its tower's only pose and moved that tower
+  sideways only (a joint-1 offset or sign typo, a flat station's slot one height off along its row, a joint-5 offset
+  within a tower's own tilt): nothing but the base's layout could see it, and real towers stand 12-105 mm from
+  that. The output names the tower as resting on one pose and the pose that would check it (:func:`unseen`).
 
 Anything else is a failure (``bent``, ``unnamed``, ``not first``...). ``python -m tests.support.gross_matrix [--fast]``
 prints the counts (with ``PYTHONPATH`` naming another tree: that tree's counts).
@@ -49,7 +53,7 @@ FLAG_MM = 8.0
 """[mm] the audit's always-flagged distance (:data:`ur3hanoi.calibrate.limits.CONTACT_FLAG_MM`)."""
 HIDDEN_TOWER_MM = 1.5
 """[mm] how far each tower of a hidden station stands from its layout moved as a whole."""
-ALLOWED = ("named", "refused", "undecided", "kept")
+ALLOWED = ("named", "refused", "undecided", "kept", "said")
 HIDDEN = {"lab_real": (2.0, (5.0, -4.0, 1.0)), "ur3e_sim": (-1.5, (-6.0, 3.0, 0.5)), "lab_sim": (1.5, (4.0, 5.0, 0.0))}
 """Each shipped station's hidden twin: its towers turned [deg] about their centroid and moved [mm]."""
 
@@ -165,8 +169,12 @@ def tower_error_mm(fitted: Station, truth: Station) -> float:
                for t in range(truth.n_towers) for h in range(truth.n_heights))
 
 
-def outcome(case: Case) -> tuple[str, str]:
-    """(the outcome, what was said) of calibrating ``case`` (see the module docstring)."""
+def outcome(case: Case, named_ref: Station | None = None, kept_ref: Station | None = None,
+            slack_mm: float = HIDDEN_TOWER_MM, named_mm: float = TOWER_MM) -> tuple[str, str]:
+    """(the outcome, what was said) of calibrating ``case`` (see the module docstring). ``named_ref``: where the
+    good points put the towers (default: the truth), ``kept_ref``: where all the good points do (default: the truth),
+    ``slack_mm``: how far the truth's towers may stand from their own points (the hidden towers' offsets, or the
+    recording noise); ``named_mm``: how close a point named and left out leaves every tower to ``named_ref``."""
     try:
         fit = fit_station(case.truth.base, case.taught)
     except TaughtPointsError as exc:  # too little left to fit: the message lists what was left out
@@ -180,14 +188,40 @@ def outcome(case: Case) -> tuple[str, str]:
             return "undecided", said
         named = any(s.index == case.wrong for s in fit.suspects)
         return "refused, named not first" if named else "refused, unnamed", said
-    worst = tower_error_mm(fit.station, case.truth.truth)
     if not fit.used[case.wrong]:
+        worst = tower_error_mm(fit.station, named_ref or case.truth.truth)
+        if not first and fit.consensus == "agree" and tower_error_mm(
+                fit.station, kept_ref or case.truth.truth) <= FLAG_MM + slack_mm:
+            return "kept", said  # within the station's scatter: the fit's finer pruning ranks it among noisy ones
         if not first:
             return "left out, named not first", said
-        return ("named", said) if worst <= TOWER_MM else (f"named, but a tower {worst:.1f} mm off", said)
-    if worst <= FLAG_MM + HIDDEN_TOWER_MM:
+        return ("named", said) if worst <= named_mm else (f"named, but a tower {worst:.1f} mm off", said)
+    worst = tower_error_mm(fit.station, kept_ref or case.truth.truth)
+    if worst <= FLAG_MM + slack_mm:
         return "kept", said
+    if unseen(case, fit.station, fit.single_pose, slack_mm):
+        return "said", said
     return f"written bent: a tower {worst:.1f} mm off", said
+
+
+def unseen(case: Case, fitted: Station, single_pose: tuple[tuple[int, int, float], ...],
+           slack_mm: float = HIDDEN_TOWER_MM) -> bool:
+    """Whether the wrong point, written, moved only what no evidence sees, and the output says so (issue 37): its
+    tower rests on it alone (named in :attr:`ur3hanoi.calibrate.result.CalibrationFit.single_pose`), and the
+    calibration differs from the truth sideways only: every level within the always-flagged distance (plus the
+    hidden towers' own offsets), and every good point's slot too (on a flat station whose step the points do not fix,
+    a wrong end tower turns the row, and the untaught rows of the others with it)."""
+    t_wrong = case.slots[case.wrong][0]
+    if (t_wrong, case.wrong) not in {(t, i) for t, i, _ in single_pose}:
+        return False
+    truth, limit = case.truth.truth, FLAG_MM + slack_mm
+    for t in range(truth.n_towers):
+        for h in range(truth.n_heights):
+            d = (contact_point_world(fitted, t, h) - contact_point_world(truth, t, h)) * 1e3
+            taught = any(s[:2] == (t, h) for i, s in enumerate(case.slots) if i != case.wrong and s[0] != t_wrong)
+            if abs(float(d[2])) > limit or (taught and float(np.linalg.norm(d)) > limit):
+                return False
+    return True
 
 
 def tally(fast: bool = False) -> tuple[Counter[str], list[str]]:

@@ -59,7 +59,8 @@ def station(folder: Path, name: str, *args: str) -> subprocess.Popen[str]:
     with open(out, "w") as stdout, open(folder / f"{name}.err", "w") as stderr:
         proc = subprocess.Popen([sys.executable, "-m", "ur3hanoi.cli", "ros2-station", "--report",
                                  str(folder / f"{name}.json"), *args], stdout=stdout, stderr=stderr, text=True)
-    if wait_for(lambda: "ros2-station: ready" in out.read_text() or proc.poll() is not None, 90.0) is None \
+    err = folder / f"{name}.err"  # the ready line is on stderr: stdout carries the JSON report alone
+    if wait_for(lambda: "ros2-station: ready" in err.read_text() or proc.poll() is not None, 90.0) is None \
             or proc.poll() is not None:
         proc.kill()
         raise SystemExit(f"station {name} not ready: {out.read_text()} {(folder / f'{name}.err').read_text()}")

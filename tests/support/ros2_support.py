@@ -41,7 +41,7 @@ UR3HANOI = f"{sys.executable} -m ur3hanoi.cli"
 
 PRELUDE = """set -u
 ip link set lo up && ip link set lo multicast on
-wait_ready() {  # wait_ready FILE: until the station printed its ready line (60 s at most)
+wait_ready() {  # wait_ready FILE: until the station printed its ready line (on its stderr; 60 s at most)
   for _ in $(seq 1 300); do grep -q "ros2-station: ready" "$1" && return 0; sleep 0.2; done
   echo "station not ready" >&2; cat "$1" >&2; return 1
 }

@@ -113,6 +113,17 @@ class Station:
         assert code == 0, f"ros-station exited with {code}:\n{self.log()}"
         return self.read_report()
 
+    def stop_json(self, sig: signal.Signals = signal.SIGTERM) -> dict[str, Any]:
+        """Stop a station started without ``--report`` with ``sig``, wait for exit 0, and return its stdout read
+        as one JSON document: the report, and nothing else."""
+        self.proc.send_signal(sig)
+        try:
+            code = self.proc.wait(timeout=STOP_TIMEOUT_S)
+        finally:
+            self.kill()
+        assert code == 0, f"ros-station exited with {code}:\n{self.log()}"
+        return json.loads("".join(self.stdout))
+
     def kill(self) -> None:
         if self.proc.poll() is None:
             os.killpg(self.proc.pid, signal.SIGKILL)
@@ -143,13 +154,16 @@ def roscore(env: dict[str, str]) -> Iterator[None]:
 
 
 @contextmanager
-def station(env: dict[str, str], tmp_path: Path, *args: str) -> Iterator[Station]:
-    """``ur3hanoi ros-station --report tmp_path/report.json ARGS`` in its own session, ready; killed on exit."""
-    report = tmp_path / "report.json"
-    proc = subprocess.Popen(ur3hanoi_cmd("ros-station", "--report", str(report), *args), env=env, text=True,
+def station(env: dict[str, str], tmp_path: Path, *args: str, report: str | None = "report.json"
+            ) -> Iterator[Station]:
+    """``ur3hanoi ros-station --report tmp_path/report.json ARGS`` in its own session, ready; killed on exit.
+    ``report=None``: without ``--report`` (the report on stdout: :meth:`Station.stop_json`)."""
+    path = None if report is None else tmp_path / report
+    where = [] if path is None else ["--report", str(path)]
+    proc = subprocess.Popen(ur3hanoi_cmd("ros-station", *where, *args), env=env, text=True,
                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             start_new_session=True)
-    st = Station(proc, report)
+    st = Station(proc, path if path is not None else tmp_path / "no-report-file")
     try:
         st.wait_ready()
         yield st

@@ -113,14 +113,16 @@ class Robot:
         return {n: p for n, p in zip(js.name, js.position, strict=False)}
 
     def at_rest(self, timeout):
-        """Spin until the arm has stopped (two positions 0.1 s apart within 1 mrad), at most ``timeout`` [s]; the
-        seconds waited. An abort or a cancel stops the arm within its deceleration limits: from full speed that
-        takes longer than a fixed wait may allow."""
-        t0, last = time.monotonic(), self.position()
+        """Spin until the arm has stopped (three positions 0.1 s apart within 1 mrad: two would also match either
+        side of an overshoot's turning point), at most ``timeout`` [s]; the seconds waited. An abort or a cancel
+        stops the arm within its deceleration limits: from full speed that takes longer than a fixed wait may
+        allow."""
+        t0, last, still = time.monotonic(), self.position(), 0
         while time.monotonic() - t0 < timeout:
             self.spin_until(lambda: False, 0.1)
             now = self.position()
-            if max(abs(now[j] - last[j]) for j in ROBOT_JOINTS) < 1e-3:
+            still = still + 1 if max(abs(now[j] - last[j]) for j in ROBOT_JOINTS) < 1e-3 else 0
+            if still == 2:
                 break
             last = now
         return time.monotonic() - t0

@@ -104,7 +104,7 @@ def main():
     executor.add_node(node)
     thread = threading.Thread(target=executor.spin, daemon=True)
     thread.start()
-    print("ur3hanoi ros2-station: ready (stand-in)", flush=True)
+    print("ur3hanoi ros2-station: ready (stand-in)", file=sys.stderr, flush=True)  # as the station: stdout = report
     try:
         while True:
             time.sleep(0.1)

@@ -29,7 +29,7 @@ def test_a_practice_session_over_dds_teaches_the_hidden_station_and_ros2_solve_s
 $UR3HANOI ros2-station --calibration {tmp_path}/hidden.yaml --timing honest --report {tmp_path}/report.json \\
   > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 {sys.executable} -m tests.support.teach_operator {tmp_path} ros2 > {tmp_path}/operator.json \\
   || {{ kill -INT $ST; exit 91; }}
 $UR3HANOI ros2-solve --table {tmp_path}/lab2_data.yaml --key real_pos --calibration {tmp_path}/station.yaml \\

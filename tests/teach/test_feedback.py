@@ -15,7 +15,7 @@ from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints, parse_taught
 from ur3hanoi.io.resources import TAUGHT_EXAMPLE, stations_dir
 from ur3hanoi.station.calibration import Station, load_station
 from ur3hanoi.tables.ik_table import generate_table
-from ur3hanoi.teach.feedback import BY_LAYOUT, BY_POINTS, feedback
+from ur3hanoi.teach.feedback import BY_LEVEL, BY_POINTS, feedback
 from ur3hanoi.teach.jog import Jogger
 
 
@@ -54,23 +54,30 @@ FIRST = [(0, 2), (1, 0), (2, 0)]
 ALL_CHECKED = [*FIRST, (0, 0), (1, 2), (2, 2)]
 
 
-def test_three_good_points_agree_judged_by_the_layout(base: Station, hidden: Station) -> None:
+def test_three_good_points_agree_judged_by_the_table_s_level(base: Station, hidden: Station) -> None:
     fb = feedback(base, taught(hidden, FIRST, {0: (0.7, -0.5, 0.4), 2: (0.0, 0.8, -0.3)}), "lab_real")
     assert fb.suspects == () and fb.problem == "" and fb.fit is not None
-    assert all(r.by == BY_LAYOUT and r.off_mm < 3.0 and not r.suspect for r in fb.rows)
-    assert math.isclose(fb.layout_turn_deg, 2.0, abs_tol=0.5)
+    assert all(r.by == BY_LEVEL and r.off_mm < 3.0 and not r.suspect for r in fb.rows)
+    assert math.isclose(fb.layout_turn_deg, 2.0, abs_tol=0.5) and fb.single == (0, 1, 2)
     text = "\n".join(fb.lines("lab_real"))
-    assert "every point agrees with the others" in text and "the layout of lab_real" in text
+    assert ("every point agrees with the others; towers 1, 2 and 3 rest on one pose: nothing checks where it stands "
+            "along the table") in text and "the other towers' level (not sideways)" in text
+
+
+def test_a_tower_30_mm_along_the_table_agrees_and_is_said(base: Station, hidden: Station) -> None:
+    """Issue 37: where a tower taught once stands along the table, only the base's layout could say."""
+    fb = feedback(base, taught(hidden, FIRST, {1: (0.0, 30.0, 0.0)}), "lab_real")
+    assert fb.suspects == () and fb.problem == "" and fb.single == (0, 1, 2)
 
 
 def test_a_third_pose_15_mm_off_is_named_at_once(base: Station, hidden: Station) -> None:
     fb = feedback(base, taught(hidden, FIRST, {2: (0.0, 0.0, 15.0)}), "lab_real")
     assert [i for i, _ in fb.suspects] == [2]
     row = fb.rows[2]
-    assert row.suspect and row.by == BY_LAYOUT and math.isclose(row.off_mm, 15.0, abs_tol=1.5)
+    assert row.suspect and row.by == BY_LEVEL and math.isclose(row.off_mm, 15.0, abs_tol=1.5)
     line = fb.suspects[0][1]
-    assert line.startswith(f"tower 3 height 1 is {row.off_mm:.1f} mm from where the other points put it (with the "
-                           "tower spacing and block size of lab_real); ")
+    assert line.startswith(f"tower 3 height 1 is {row.off_mm:.1f} mm off the level where the other towers put height "
+                           "1 (one flat table, blocks of lab_real); ")
     assert line.count("re-record it") == 1, line
     assert not fb.rows[0].suspect and fb.rows[0].off_mm < 3.0
     text = "\n".join(fb.lines("lab_real"))
@@ -78,9 +85,9 @@ def test_a_third_pose_15_mm_off_is_named_at_once(base: Station, hidden: Station)
 
 
 def test_points_the_others_check_are_judged_by_the_calibrations_fit(base: Station, hidden: Station) -> None:
-    fb = feedback(base, taught(hidden, ALL_CHECKED, {4: (15.0, 0.0, 0.0)}), "lab_real")
-    # Without the named point, tower 2 has one contact left: the layout judges it, the points all the others.
-    assert [r.by for r in fb.rows] == [BY_POINTS, BY_LAYOUT, BY_POINTS, BY_POINTS, BY_POINTS, BY_POINTS]
+    fb = feedback(base, taught(hidden, ALL_CHECKED, {4: (0.0, 0.0, 15.0)}), "lab_real")
+    # Without the named point, tower 2 has one contact left: its level judges it, the points all the others.
+    assert [r.by for r in fb.rows] == [BY_POINTS, BY_LEVEL, BY_POINTS, BY_POINTS, BY_POINTS, BY_POINTS]
     assert [i for i, _ in fb.suspects] == [4] and fb.rows[4].suspect
     assert math.isclose(fb.rows[4].off_mm, 15.0, abs_tol=1.5)
     assert fb.suspects[0][1].startswith(f"tower 2 height 3 is {fb.rows[4].off_mm:.1f} mm from where the other "
@@ -122,12 +129,15 @@ def test_a_pose_recorded_in_the_wrong_slot_says_which_slot(base: Station, hidden
 
 
 def test_two_points_the_evidence_cannot_tell_apart_are_both_named(base: Station, hidden: Station) -> None:
-    fb = feedback(base, taught(hidden, ALL_CHECKED, {1: (5.0, 0.0, 0.0), 4: (-6.0, 0.0, 0.0)}), "lab_real")
+    fb = feedback(base, taught(hidden, ALL_CHECKED, {1: (7.0, 0.0, 0.0), 4: (-8.0, 0.0, 0.0)}), "lab_real")
     assert len(fb.suspects) == 1 and fb.rows[1].suspect and fb.rows[4].suspect
     line = fb.suspects[0][1]
     assert line.startswith("the points cannot tell which of ") and "tower 2 height 1 [points[1]]" in line
     assert "tower 2 height 3 [points[4]]" in line and "teach another height of tower 2" in line
     assert fb.fit is not None and not fb.fit.sound
+    # 11 mm apart: the station's scatter (issue 37), as f and calibrate judge it.
+    fb = feedback(base, taught(hidden, ALL_CHECKED, {1: (5.0, 0.0, 0.0), 4: (-6.0, 0.0, 0.0)}), "lab_real")
+    assert fb.fit is not None and fb.fit.sound and not any(r.suspect for r in fb.rows[:3])
 
 
 def test_too_few_towers_says_why_there_is_no_calibration_yet(base: Station, hidden: Station) -> None:

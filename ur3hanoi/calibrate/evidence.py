@@ -1,8 +1,10 @@
-"""Judge a set of taught points on all the evidence a calibration has: where they are, the tool's orientation, the
-height step and block size, the approach, and the base calibration's layout moved and turned as a whole
-(:func:`judge`; :mod:`ur3hanoi.calibrate.consensus` tries the sets without each point in turn).
+"""Judge a set of taught points on all the evidence a calibration has that does not depend on where the towers
+stand: where the points are, the table's levels, the tool's axis, the height step and block size, the approach,
+distinct towers (:func:`judge`; :mod:`ur3hanoi.calibrate.consensus` tries the sets without each point in turn).
 
-The evidence, each with the audit's always-flagged limit (:mod:`ur3hanoi.calibrate.limits`); a set of points is
+The base calibration gives the robot, the tool, the block size and the approach, not where the towers stand: real
+stations' towers stand 12-105 mm from where its layout, moved and turned as a whole, puts them (issue 37). The
+evidence, each with the audit's always-flagged limit (:mod:`ur3hanoi.calibrate.limits`); a set of points is
 consistent when nothing is over its limit:
 
 - **positions**: a contact that the others check (its tower has another contact, or the step is fitted without it)
@@ -10,37 +12,40 @@ consistent when nothing is over its limit:
   its horizontal place, within :data:`ABOVE_FLAG_LINE_MM`, 10 mm: its height is the approach's);
 - **the height step and the block size**: when one tower alone fixes the step, the top level it gives is within
   8 mm of where the base's step (one block up; a flat base: its row step turned with the towers) puts it;
-- **the base's layout moved and turned as a whole**: a tower taught at one contact only stands within 8 mm of where
-  the base's layout, fitted to the other towers, puts it (:func:`ur3hanoi.calibrate.layout.tower_place`); a tower
-  the student vouched for (``accepted``) is not judged, nor used to place the others;
-- **the tool's orientation**: a contact's suction axis is within :data:`TILT_FLAG_DEG` (5 deg) of the others' (their
-  robust mean, :func:`ur3hanoi.calibrate.limits.table_axis`); its heading (the direction the arm came from) is
-  weighed, never alone a reason (a round cup does not care, and freedrive turns it): a heading more than
-  ``max(HEADING_DEG, 5 x the others' spread)`` from the others' counts against the point when hypotheses compete;
+- **the table's levels, the tool's axis, distinct towers** (:mod:`ur3hanoi.calibrate.table_checks`): every
+  tower's origin at the other towers' height within 8 mm; a contact's suction axis within :data:`TILT_FLAG_DEG`
+  (5 deg) of its tower's other contacts', a tower's within 8 deg of the other towers'; towers a block apart. A
+  tower the student vouched for (``accepted``) is not judged by these;
+- **the tool's heading** (the direction the arm came from) is weighed, never alone a reason (a round cup does not
+  care, and freedrive turns it): a heading more than ``max(HEADING_DEG, 5 x the others' spread)`` from the others'
+  counts against the point when hypotheses compete;
 - **the approach**: an above pose stands within :data:`ABOVE_FLAG_LINE_MM` (10 mm) of its tower's vertical line,
   at least :data:`ABOVE_MIN_MM` (5 mm) and at most :data:`MAX_APPROACH_M` over its contact, and as high over it as
   the other above poses (the calibration has one approach height): within ``max(8 mm, 5 x their spread)``.
+
+A tower taught at one contact is judged by its level and axis only: nothing checks where it stands along the table
+(a joint-1 offset moves it with nothing else changed); the calibration says so
+(:attr:`ur3hanoi.calibrate.result.CalibrationFit.single_pose`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.calibrate.grid_fit import BoolArray, Measured, default_height_step
-from ur3hanoi.calibrate.layout import LayoutFit, fit_layout, tower_place
+from ur3hanoi.calibrate.grid_fit import FLAT_STEP_PASSES, BoolArray, Measured, default_height_step
+from ur3hanoi.calibrate.layout import LayoutFit, fit_layout
 from ur3hanoi.calibrate.limits import (
     ABOVE_FLAG_LINE_MM,
     ABOVE_MIN_MM,
     CONTACT_FLAG_MM,
     MAX_APPROACH_M,
     TILT_FLAG_DEG,
-    angle_deg,
-    table_axis,
 )
+from ur3hanoi.calibrate.table_checks import TOWER_TILT_DEG, distinct_checks, level_checks, share, tilt_checks
 from ur3hanoi.errors import printable
 from ur3hanoi.robot.ik import wrap_angle
 from ur3hanoi.station.calibration import Station
@@ -49,10 +54,14 @@ from ur3hanoi.tables import Slot
 
 HEADING_DEG = 15.0
 """[deg] a heading this far from the others' (or 5 times their spread) weighs against a point."""
+UNJUDGED_SCORE = 2.0
+"""What an above pose left with nothing to judge it adds to a hypothesis' score (two checks at their limit): with
+its tower's only contact left out, it would agree with anything."""
 SPREAD_SIGMAS = 5.0
 """Headings and approach heights: a point past this many times the others' spread (their median deviation) disagrees
 when that is more than the limit (the data's own scatter sets the bar where hand-recorded tables scatter widely)."""
-BY_POINTS, BY_LAYOUT = "points", "layout"
+BY_POINTS, BY_LEVEL = "points", "level"
+BY_LAYOUT = BY_LEVEL  # the name issue 33 used; a tower taught once is judged by its level now
 
 
 @dataclass(frozen=True)
@@ -67,6 +76,7 @@ class Check:
     value: float
     share: float
     soft: bool = False
+    other: int = -1
 
     @property
     def over(self) -> bool:
@@ -85,8 +95,11 @@ class Judgement:
         expected_m: (N, 3) [m, world] where the kept points put each point's slot (NaN where they cannot say).
         off_mm: (N,) each point's distance [mm] from where the others put it: for a kept point the check that
             judged it (NaN when none could), for one left out its distance from ``expected_m``.
-        by: per point, :data:`BY_POINTS` or :data:`BY_LAYOUT` (what placed it), or "".
-        layout: the base's layout fitted to the kept towers (None with none).
+        by: per point, :data:`BY_POINTS` (the other points placed it) or :data:`BY_LEVEL` (its tower's only
+            contact: only its height is judged, by the other towers' level), or "".
+        layout: the base's layout fitted to the kept towers (None with none): a hint, never evidence.
+        level_m: (H,) [m, world] each height's level where the kept towers put it (NaN with none).
+        unjudged: how many kept above poses stand over a tower with no kept contact (nothing judges them).
     """
 
     kept: BoolArray
@@ -98,6 +111,8 @@ class Judgement:
     off_mm: FloatArray
     by: tuple[str, ...]
     layout: LayoutFit | None
+    level_m: FloatArray = field(default_factory=lambda: np.zeros(0))
+    unjudged: int = 0
 
     @property
     def consistent(self) -> bool:
@@ -105,7 +120,9 @@ class Judgement:
 
     @property
     def score(self) -> float:
-        return float(sum(c.share**2 for c in self.checks if not c.soft or c.over))
+        """The checks' squared shares of their limits, plus :data:`UNJUDGED_SCORE` for each kept above pose over a
+        tower with no kept contact: a hypothesis that leaves a point nothing can judge explains less."""
+        return float(sum(c.share**2 for c in self.checks if not c.soft or c.over)) + UNJUDGED_SCORE * self.unjudged
 
 
 @dataclass(frozen=True)
@@ -194,7 +211,7 @@ def _grid(ev: Evidence, kept: np.ndarray) -> tuple[FloatArray, FloatArray, bool,
     h_rows = np.array([ev.slots[i][1] for i, _ in rows], dtype=float)
     a_rows = np.array([a for _, a in rows], dtype=int)
     step, origins, x = default_height_step(base, None), np.full((n_t, 3), np.nan), np.zeros(A.shape[1])
-    for _ in range(1 if fitted else 3):  # an unfitted flat step turns with the towers it places
+    for _ in range(1 if fitted else FLAT_STEP_PASSES):  # an unfitted flat step turns with the towers it places
         if rows:
             x = np.linalg.lstsq(A, p - (0.0 if fitted else h_rows * step[a_rows]), rcond=None)[0]
             origins = np.where(present[:, None], x[:3 * n_t].reshape(n_t, 3), np.nan)
@@ -202,7 +219,11 @@ def _grid(ev: Evidence, kept: np.ndarray) -> tuple[FloatArray, FloatArray, bool,
             step = np.zeros(3)
             step[list(axes)] = x[3 * n_t:3 * n_t + len(axes)]
         else:
-            step = _prior_step(base, origins)
+            new = _prior_step(base, origins)
+            settled = bool(np.max(np.abs(new - step)) < 1e-13)
+            step = new
+            if settled:
+                break
     dev, can = np.full((n, 3), np.nan), np.zeros(n, dtype=bool)
     if rows:
         residual = p - A @ x - (0.0 if fitted else h_rows * step[a_rows])
@@ -236,25 +257,28 @@ def _headings(ev: Evidence, kept: np.ndarray) -> list[Check]:
                                                                                                   strict=True)]
 
 
-def _layout_checks(ev: Evidence, origins: FloatArray, single: dict[int, int], accepted_towers: set[int]
-                   ) -> tuple[list[Check], dict[int, FloatArray], LayoutFit | None]:
-    """Each tower taught once against the base's layout fitted to the other towers; where the layout puts every
-    tower [mm]; the layout fitted to all the towers (the accepted ones aside)."""
-    base_mm, fitted_mm = ev.base_origins_mm, origins * 1e3
-    pivot = base_mm.mean(axis=0)
+def _layout(ev: Evidence, origins: FloatArray) -> LayoutFit | None:
+    """The base's layout moved and turned onto the towers the points place (how far they stand from it, for people:
+    never evidence, real towers stand anywhere); None with none."""
+    base_mm = ev.base_origins_mm
     present = [t for t in range(len(origins)) if not np.isnan(origins[t, 0])]
-    refs = [t for t in present if t not in accepted_towers]
-    checks, places = [], {}
-    for t in range(len(origins)):
-        place = tower_place(base_mm, fitted_mm, t, [r for r in refs if r != t], pivot)
-        if place is None:
-            continue
-        places[t] = place
-        if t in single and t not in accepted_towers:
-            d = float(np.linalg.norm(fitted_mm[t] - place))
-            checks.append(Check("layout", t, d, d / CONTACT_FLAG_MM))
-    whole = fit_layout(base_mm[refs], fitted_mm[refs], pivot) if refs else None
-    return checks, places, whole
+    return fit_layout(base_mm[present], origins[present] * 1e3, base_mm.mean(axis=0)) if present else None
+
+
+def _table_checks(ev: Evidence, origins: FloatArray, contact: np.ndarray, accepted_towers: set[int]) -> list[Check]:
+    """The layout-independent evidence (:mod:`ur3hanoi.calibrate.table_checks`): levels, the tool's axis, distinct
+    towers."""
+    towers = [ev.slots[i][0] for i in contact]
+    judged = [t for t in sorted(set(towers)) if t not in accepted_towers]
+    checks = [Check("level", t, dz, share(dz, CONTACT_FLAG_MM)) for t, dz in level_checks(origins, judged)]
+    per_point, lean = tilt_checks(ev.m.R_world[contact, :, 2], towers)
+    checks += [Check("tilt", int(contact[j]), a, a / TILT_FLAG_DEG) for j, a in per_point]
+    checks += [Check("lean", t, a, a / TOWER_TILT_DEG) for t, a in lean if t not in accepted_towers]
+    block_mm = ev.base.block_size * 1e3
+    checks += [Check("distinct", a, d, block_mm / max(d, 1e-6), other=b)
+               for a, b, d in distinct_checks(origins, ev.base.block_size)
+               if not (a in accepted_towers and b in accepted_towers)]
+    return checks
 
 
 def judge(ev: Evidence, kept: BoolArray) -> Judgement:
@@ -283,30 +307,33 @@ def judge(ev: Evidence, kept: BoolArray) -> Judgement:
     towers = [ev.slots[i][0] for i in contact]
     single = {t: int(contact[j]) for j, t in enumerate(towers) if towers.count(t) == 1}
     accepted_towers = {ev.slots[i][0] for i in contact if ev.accepted[i]}
-    layout_checks, places, layout = _layout_checks(ev, origins, single, accepted_towers)
-    checks += layout_checks
-    for c in layout_checks:
-        off[single[c.index]], by[single[c.index]] = c.value, BY_LAYOUT
-    if len(contact):
-        axes = ev.m.R_world[contact, :, 2]
-        tilt = angle_deg(axes, table_axis(axes))
-        checks += [Check("tilt", int(i), float(a), float(a) / TILT_FLAG_DEG)
-                   for i, a in zip(contact, tilt, strict=True)]
-    expected, under = _expected(ev, origins, step, places, kept)
+    layout = _layout(ev, origins)
+    table = _table_checks(ev, origins, contact, accepted_towers)
+    checks += table
+    for c in table:  # a tower taught once: judged by its level alone (nothing checks it sideways)
+        if c.what == "level" and c.index in single:
+            off[single[c.index]], by[single[c.index]] = abs(c.value), BY_LEVEL
+    expected, under = _expected(ev, origins, step, kept)
+    present = ~np.isnan(origins[:, 0])
+    z0 = float(np.median(origins[present, 2])) if present.any() else np.nan
+    level = np.array([z0 + h * step[2] for h in range(ev.base.n_heights)])  # [m] each height's level on the table
     for i in np.flatnonzero(kept & ~is_on):
         checks += _above_checks(ev, int(i), under[i], bool(can[i]))
     checks += _approach_checks(ev, [int(i) for i in np.flatnonzero(kept & ~is_on) if not np.isnan(under[i, 0])],
                                under)
     checks += _headings(ev, np.flatnonzero(kept))
     for i in np.flatnonzero(~kept):
-        off[i] = float(np.linalg.norm(ev.m.p_world[i] - expected[i])) * 1e3
-        by[i] = BY_POINTS if not np.isnan(origins[ev.slots[i][0], 0]) else BY_LAYOUT
+        t, h, _ = ev.slots[i]
+        if not np.isnan(origins[t, 0]):
+            off[i], by[i] = float(np.linalg.norm(ev.m.p_world[i] - expected[i])) * 1e3, BY_POINTS
+        elif is_on[i] and not np.isnan(level[h]):  # its tower's only contact: only the level can say
+            off[i], by[i] = abs(float(ev.m.p_world[i, 2] - level[h])) * 1e3, BY_LEVEL
     return Judgement(kept=kept.copy(), checks=tuple(checks), origins_m=origins, step_m=step, step_fitted=step_fitted,
-                     expected_m=expected, off_mm=off, by=tuple(by), layout=layout)
+                     expected_m=expected, off_mm=off, by=tuple(by), layout=layout, level_m=level,
+                     unjudged=int(sum(np.isnan(under[i, 0]) for i in np.flatnonzero(kept & ~is_on))))
 
 
-def _expected(ev: Evidence, origins: FloatArray, step: FloatArray, places: dict[int, FloatArray],
-              kept: BoolArray) -> tuple[FloatArray, FloatArray]:
+def _expected(ev: Evidence, origins: FloatArray, step: FloatArray, kept: BoolArray) -> tuple[FloatArray, FloatArray]:
     """Where the kept points put each point's slot [m]: the tower's origin (the layout's place for a tower with no
     kept contact) plus its height's steps, an above pose at the kept above poses' approach (else the base's); and
     the contact point under each slot."""
@@ -314,9 +341,8 @@ def _expected(ev: Evidence, origins: FloatArray, step: FloatArray, places: dict[
     for i, (t, h, _) in enumerate(ev.slots):
         if not 0 <= t < ev.base.n_towers:
             continue
-        o = origins[t] if not np.isnan(origins[t, 0]) else (places[t] * 1e-3 if t in places else None)
-        if o is not None:
-            contact[i] = o + h * step
+        if not np.isnan(origins[t, 0]):  # a tower with no kept contact stands anywhere: nothing to expect
+            contact[i] = origins[t] + h * step
     above = [i for i in np.flatnonzero(kept) if ev.slots[i][2] == ABOVE and not np.isnan(contact[i, 0])]
     over = [float(ev.m.p_world[i][2] - contact[i][2]) for i in above]
     approach = float(np.median(over)) if over else ev.base.approach
@@ -354,4 +380,5 @@ def _approach_checks(ev: Evidence, above: list[int], under: FloatArray) -> list[
     return out
 
 
-__all__ = ["BY_LAYOUT", "BY_POINTS", "HEADING_DEG", "SPREAD_SIGMAS", "Check", "Evidence", "Judgement", "judge"]
+__all__ = ["BY_LAYOUT", "BY_LEVEL", "BY_POINTS", "HEADING_DEG", "SPREAD_SIGMAS", "UNJUDGED_SCORE", "Check",
+           "Evidence", "Judgement", "judge"]

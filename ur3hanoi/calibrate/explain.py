@@ -280,6 +280,32 @@ def joint_typo_point(robot: Ur3Model, T_world_base: pin.SE3, q: Sequence[float],
                      explains=False)
 
 
+def joint_typo_level(robot: Ur3Model, T_world_base: pin.SE3, q: Sequence[float], z_level: float, axis: FloatArray,
+                     scale_mm: float, scale_deg: float) -> JointTypo | None:
+    """:func:`joint_typo_point` for a tower's only contact, whose place nothing else gives: the single-joint change
+    of ``q`` [rad] that best brings the suction point to the height ``z_level`` [m, world] and the suction axis onto
+    ``axis``; its residual in mm is the height's alone."""
+    q0 = np.asarray(q, dtype=float)
+    T = T_world_base * robot.fk(q0, "tcp")
+    z = T.rotation[:, 2]
+    w = np.cross(z, axis)
+    s = float(np.linalg.norm(w))
+    turn = w / s * math.atan2(s, float(z @ axis)) if s > 1e-12 else np.zeros(3)
+    target = np.array([T.translation[0], T.translation[1], z_level])
+
+    def errors(qj: FloatArray) -> tuple[float, float]:
+        Tj = T_world_base * robot.fk(qj, "tcp")
+        dt = math.degrees(math.acos(float(np.clip(Tj.rotation[:, 2] @ axis, -1.0, 1.0))))
+        return abs(float(Tj.translation[2]) - z_level) * 1e3, dt
+
+    best = _best_single_joint(robot, T_world_base, q0, target, turn, scale_mm, scale_deg, errors)
+    if best is None:
+        return None
+    j, delta, dp, dt = best
+    return JointTypo(joint=j, recorded=float(q0[j]), predicted=float(q0[j] + delta), residual_mm=dp, residual_deg=dt,
+                     explains=False)
+
+
 TYPO_SHARE = 0.25
 """A single-joint change is called a likely typo only when it leaves at most this share of the deviation (and at
 most the never-flagged distance and tilt): one joint explains most of a large error."""

@@ -37,7 +37,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ur3hanoi.arrays import FloatArray
-from ur3hanoi.calibrate.consensus import Consensus
+from ur3hanoi.calibrate.consensus import SCATTER_SHARE, Consensus
 from ur3hanoi.calibrate.evidence import judge
 from ur3hanoi.calibrate.explain import diagnose
 from ur3hanoi.calibrate.grid_fit import (
@@ -51,6 +51,7 @@ from ur3hanoi.calibrate.limits import ABOVE_FLAG_LINE_MM, CONTACT_FLAG_MM, MAX_A
 from ur3hanoi.calibrate.prepare import MAX_TILT_DEG, Prepared, fail, prepare, underdetermined
 from ur3hanoi.calibrate.result import CalibrationFit, Suspect
 from ur3hanoi.calibrate.robust import RobustFit, robust_fit
+from ur3hanoi.calibrate.table_checks import single_pose_towers
 from ur3hanoi.calibrate.taught import TaughtPoint, TaughtPoints
 from ur3hanoi.calibrate.verdict import named_text, refusal, slot_text, unexplained, where_text
 from ur3hanoi.errors import CalibrationError, printable
@@ -207,6 +208,8 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
         raise underdetermined(where, base, points, candidates, prep.hard)
     fit = robust_fit(base, model, prep.safe_slots, prep.m, candidates, tol_mm, tol_deg)
     c = prep.consensus
+    if c.kind in ("undecided", "unexplained") and _scatter(c, fit, prep):
+        c = replace(c, kind="agree", wrong=(), alone=False, chosen=c.whole)
     named = {i: named_text(prep.evidence, c, i, points) for i in c.wrong}
     refused = c.kind == "undecided" or (c.kind == "named" and c.alone)
     problem = refusal(prep.evidence, c, points) if refused else ""
@@ -217,7 +220,8 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
         model = choose_model(base, [s for s, k in zip(slots, candidates, strict=True) if k])
         assert model is not None  # its tower has another contact
         fit = robust_fit(base, model, prep.safe_slots, prep.m, candidates, tol_mm, tol_deg)
-    if c.kind in ("agree", "named") and not refused and _bends(fit, prep, agreeing):
+    if c.kind in ("agree", "named") and not refused and (_bends(fit, prep, agreeing) or _tilt_only(fit, prep,
+                                                                                                  agreeing)):
         # The finer pruning left out points that agree with the rest, and the grid moved more than the
         # always-flagged distance from them: they agree, so they all stay.
         candidates = agreeing
@@ -235,23 +239,15 @@ def fit_station(base: Station, taught: TaughtPoints | Sequence[TaughtPoint], nam
 def _with_consensus(fit: CalibrationFit, prep: Prepared, c: Consensus) -> CalibrationFit:
     """The fit with what the consensus said: each point's distance from where the others put it, the points taken
     on the student's word, and, when no single point explains a disagreement the robust fit left, why."""
-    accepted: tuple[tuple[int, float], ...] = ()
-    if prep.evidence.accepted.any():  # how far the layout would have put their towers
-        kept = prep.candidates & ~np.isin(np.arange(len(fit.points)), c.wrong)
-        word = replace(prep.evidence, accepted=np.zeros(len(fit.points), dtype=bool))
-        layout = {ch.index: ch.value for ch in judge(word, kept).checks if ch.what == "layout"}
-        accepted = tuple((int(i), float(layout.get(fit.points[i].tower, math.nan)))
-                         for i in np.flatnonzero(prep.evidence.accepted))
+    accepted = tuple((int(i), math.nan) for i in np.flatnonzero(prep.evidence.accepted))
+    usable = np.array(fit.used) & prep.candidates
+    single = single_pose_towers([(p.tower, p.height, p.k) for p in fit.points], usable)
+    lean = {ch.index: ch.value for ch in judge(prep.evidence, usable).checks if ch.what == "lean"}
     out = replace(fit, consensus=c.kind, named=c.wrong, off_mm=c.chosen.off_mm, judged_by=c.chosen.by,
-                  accepted=accepted)
+                  accepted=accepted,
+                  single_pose=tuple((t, i, lean.get(t, math.nan)) for t, i in sorted(single.items())))
     if c.kind == "unexplained" and fit.sound:
-        # The robust fit's choice, judged again; a tower it kept one of several contacts of stands where they agree
-        # (swapped heights, say), so only a tower taught once is judged by the base's layout.
-        left = judge(prep.evidence, np.array(fit.used) & prep.candidates)
-        taught_once = {p.tower for i, p in enumerate(fit.points) if prep.candidates[i] and p.k == ON and sum(
-            prep.candidates[k] and q.k == ON and q.tower == p.tower for k, q in enumerate(fit.points)) == 1}
-        left = replace(left, checks=tuple(ch for ch in left.checks if ch.what != "layout" or ch.index in taught_once))
-        problem = unexplained(prep.evidence, left, fit.points)
+        problem = unexplained(prep.evidence, judge(prep.evidence, usable), fit.points)  # the robust fit's choice
         if problem:
             out = replace(out, problem=problem, warnings=(*fit.warnings, f"the fit is not sound: {problem}"))
     return out
@@ -285,7 +281,12 @@ def _calibration_fit(ctx: _Context, station: Station, model: GridModel, candidat
     if not ctx.heads:  # when the named points had to stay in the fit, it judges the others wrongly: not shown
         is_suspect |= (~fit.used & candidates) | (severity > 1.0)
     order = sorted(np.flatnonzero(is_suspect), key=lambda i: -np.nan_to_num(severity[i], nan=np.inf))
-    order = [i for i in ctx.named if i in order] + [i for i in order if i not in ctx.named]  # the named first
+    # Those that cannot take part first (a pose 117 deg from tool down is wrong whatever the others say), then the
+    # one the consensus named, then the points the fit left out, then the rest, each worst first.
+    hard = [i for i in order if ctx.hard[i]]
+    named_first = [i for i in ctx.named if i in order and i not in hard]
+    rest = [i for i in order if i not in hard and i not in ctx.named]
+    order = hard + named_first + [i for i in rest if not fit.used[i]] + [i for i in rest if fit.used[i]]
     reasons = _reasons(ctx, [int(i) for i in order])
     suspects = tuple(
         Suspect(index=int(i), tower=points[i].tower, height=points[i].height, k=points[i].k, field=points[i].where,
@@ -320,6 +321,31 @@ def _bends(fit: RobustFit, prep: Prepared, candidates: BoolArray) -> bool:
     return False
 
 
+def _scatter(c: Consensus, fit: RobustFit, prep: Prepared) -> bool:
+    """Whether what the consensus could not pin on one point is the station's scatter, as the audit judges it
+    (``check-table --fit`` calls such a table clean, and the two must agree): only contacts the others check were
+    off, each at most :data:`~ur3hanoi.calibrate.consensus.SCATTER_SHARE` of the always-flagged distance, or the
+    robust fit leaves every contact within it (a contact it left out: of the grid fitted without it)."""
+    over = [ch for ch in c.whole.checks if ch.over and not ch.soft]
+    if not over or any(ch.what != "point" for ch in over):
+        return False
+    if all(ch.share <= SCATTER_SHARE for ch in over):  # contacts up to 12 mm off the others' grid: real scatter
+        return True
+    residual = np.linalg.norm(prep.m.p_world - fit.solution.points(prep.safe_slots), axis=1) * 1e3
+    dev = np.where(fit.used & fit.removable, fit.deviation_mm, residual)
+    on = prep.candidates & np.array([s[2] == ON for s in prep.safe_slots])
+    return bool(np.all(dev[on] <= CONTACT_FLAG_MM))
+
+
+def _tilt_only(fit: RobustFit, prep: Prepared, candidates: BoolArray) -> bool:
+    """Whether the fit left out a contact the consensus kept for its orientation alone: its tower tilted alike on
+    every point (the student's wrist there: issue 37), which the consensus judges per tower."""
+    d = np.linalg.norm(prep.m.p_world - fit.solution.points(prep.safe_slots), axis=1) * 1e3
+    left = np.flatnonzero(candidates & ~fit.used)
+    return any(prep.safe_slots[i][2] == ON and fit.rot_deg[i] > fit.thresholds.deg and d[i] <= fit.thresholds.mm
+               for i in left)
+
+
 def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray, points: Sequence[TaughtPoint]) -> str:
     """Why the remaining fit cannot be trusted ("" if it can)."""
     n = int(candidates.sum())
@@ -328,14 +354,18 @@ def _soundness(fit: RobustFit, candidates: BoolArray, dev_mm: FloatArray, points
     if left_out >= max(1, (n - 1) // 2) and over.any():
         return (f"{left_out} of {n} points left out and more still disagree with the grid: check the base "
                 "calibration's robot base and tool, and the tower/height labels")
-    stuck = over & ~fit.removable  # the others do not determine the grid without them (pruning drops the others)
+    # The others do not determine the grid without them (pruning drops the others): judged by the always-flagged
+    # distance, not the fit's few-mm floors (a contact and the above pose over it disagree by twice the recording
+    # noise, 1-3 mm each, and the calibration averages them).
+    flag = np.array([CONTACT_FLAG_MM if p.k == ON else ABOVE_FLAG_LINE_MM for p in points])
+    stuck = fit.used & (dev_mm > flag) & ~fit.removable
     if stuck.any():
         worst = sorted(np.flatnonzero(stuck), key=lambda i: -dev_mm[i])
         named = [f"{slot_text(points[i])} ({dev_mm[i]:.1f} mm)" for i in worst[:3]]
         more = f" and {len(worst) - 3} more" if len(worst) > 3 else ""
         return (f"{', '.join(named)}{more}, which the fit cannot do without, {'is' if len(worst) == 1 else 'are'} "
-                f"more than {fit.thresholds.mm:.1f} mm off the grid: re-record {'it' if len(worst) == 1 else 'them'} "
-                "or add points")
+                f"more than the always-flagged {CONTACT_FLAG_MM:g} mm ({ABOVE_FLAG_LINE_MM:g} mm for an above pose) "
+                f"off the grid: re-record {'it' if len(worst) == 1 else 'them'} or add points")
     return ""
 
 

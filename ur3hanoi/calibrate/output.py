@@ -10,7 +10,7 @@ import yaml
 
 from ur3hanoi.calibrate.result import CalibrationFit
 from ur3hanoi.calibrate.taught import TaughtPoints
-from ur3hanoi.calibrate.verdict import accepted_lines
+from ur3hanoi.calibrate.verdict import note_lines
 from ur3hanoi.errors import CalibrationError, TaughtPointsError, printable
 from ur3hanoi.io.atomic import atomic_write
 from ur3hanoi.io.yaml_loader import parse_yaml
@@ -38,7 +38,7 @@ def calibration_text(fit: CalibrationFit, taught: TaughtPoints, base: Station, t
     if left_out:
         shown = ", ".join(left_out[:10]) + (f" and {len(left_out) - 10} more" if len(left_out) > 10 else "")
         head.append(f"# left out (suspect): {printable(shown, 4096)}")
-    head += [f"# {line}" for line in accepted_lines(fit.points, fit.accepted, base_label or base.source)]
+    head += [f"# {line}" for line in note_lines(fit.points, fit.accepted, fit.single_pose, base_label or base.source)]
     return "\n".join(head) + "\n" + body
 
 

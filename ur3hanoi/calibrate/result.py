@@ -97,10 +97,12 @@ class CalibrationFit:
             ``kind``: ``agree``, ``named``, ``undecided``, ``unexplained``).
         named: the points it named as wrong (indices, best first).
         off_mm: (N,) each point's distance [mm] from where the other points put it (NaN: nothing could say).
-        judged_by: per point, what placed it: ``points``, ``layout`` (the base's layout, for a tower taught once)
-            or "".
-        accepted: ``(index, mm)`` of the points taken on the student's word: how far [mm] from where the base's
-            layout, moved onto the other towers, puts their tower (NaN when nothing could say).
+        judged_by: per point, what judged it: ``points``, ``level`` (a tower's only contact: its height against the
+            other towers' level) or "".
+        accepted: ``(index, mm)`` of the points taken on the student's word (``mm``: NaN, kept for callers of
+            issue 33's form: the base's layout is no evidence of where a tower stands).
+        single_pose: ``(tower, index, lean)`` of each tower whose place rests on one pose of the fit (index): nothing
+            checks it sideways; ``lean`` [deg]: its suction axis from the other towers' (NaN: none to compare).
     """
 
     station: Station
@@ -125,6 +127,7 @@ class CalibrationFit:
     off_mm: FloatArray = field(default_factory=lambda: np.zeros(0))
     judged_by: tuple[str, ...] = ()
     accepted: tuple[tuple[int, float], ...] = ()
+    single_pose: tuple[tuple[int, int, float], ...] = ()
 
     @property
     def sound(self) -> bool:

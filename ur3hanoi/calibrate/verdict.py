@@ -25,9 +25,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from ur3hanoi.calibrate.consensus import Consensus
-from ur3hanoi.calibrate.evidence import BY_LAYOUT, HEADING_DEG, SPREAD_SIGMAS, Evidence, Judgement
-from ur3hanoi.calibrate.explain import JOINT_LABELS, TYPO_SHARE, JointTypo, angle_text, joint_typo_point
+from ur3hanoi.calibrate.evidence import BY_LEVEL, HEADING_DEG, SPREAD_SIGMAS, Check, Evidence, Judgement
+from ur3hanoi.calibrate.explain import (
+    JOINT_LABELS,
+    TYPO_SHARE,
+    JointTypo,
+    angle_text,
+    joint_typo_level,
+    joint_typo_point,
+)
 from ur3hanoi.calibrate.limits import CONTACT_FLAG_MM, CONTACT_OK_MM, TILT_FLAG_DEG, TILT_OK_DEG, table_axis
+from ur3hanoi.calibrate.table_checks import TOWER_TILT_DEG
 from ur3hanoi.calibrate.taught import TaughtPoint
 from ur3hanoi.errors import printable
 from ur3hanoi.robot.ik import wrap_angle
@@ -36,6 +44,10 @@ from ur3hanoi.station.grid import ABOVE, ON, pose_label
 
 HOME_DEG = 1.0
 """[deg] a pose whose every joint is this close to the base's home pose was recorded with the arm at home."""
+
+LEVEL_TYPO_DEG = 1.0
+"""[deg] a typo in one joint explains a tower's only contact when the change leaves its axis within this of the
+others' (or a quarter of its tilt before): its place along the table gives no other check."""
 
 Points = Sequence[TaughtPoint]
 
@@ -61,22 +73,32 @@ def accept_option(p: TaughtPoint) -> str:
 
 
 def _grid_points(ev: Evidence, j: Judgement) -> dict[tuple[int, int, int], np.ndarray]:
-    """Every slot's suction point [m] where the judged points put it (the base's layout places a tower they lack)."""
+    """Every slot's suction point [m] where the judged points put it (of the towers they place)."""
     out = {}
     for t in range(ev.base.n_towers):
-        o = j.origins_m[t]
-        if np.isnan(o[0]) and j.layout is not None:
-            o = j.layout.apply(np.asarray(ev.base.tower_origins[t]) * 1e3)[0] * 1e-3
+        o = j.origins_m[t]  # a tower with no judged contact stands anywhere: no slot of it to compare with
         for h in range(ev.base.n_heights):
             out[(t, h, ON)] = o + h * j.step_m
             out[(t, h, ABOVE)] = out[(t, h, ON)] + np.array([0.0, 0.0, ev.base.approach])
     return {s: p for s, p in out.items() if not np.isnan(p[0])}
 
 
-def _typo(ev: Evidence, p: TaughtPoint, i: int, target: np.ndarray, axis: np.ndarray) -> JointTypo | None:
+def _typo(ev: Evidence, p: TaughtPoint, i: int, target: np.ndarray, axis: np.ndarray, level: bool = False
+          ) -> JointTypo | None:
+    """The typo in one joint that explains point ``i``: one that moves it to ``target`` [m] (``level``: to its
+    height only, for a tower's only contact) with the others' suction ``axis``."""
     robot = load_ur3(ev.base.tool, ev.base.limits, ev.base.robot)
-    typo = joint_typo_point(robot, ev.base.T_world_base, p.q, target, axis, CONTACT_OK_MM, TILT_OK_DEG)
-    err = float(np.linalg.norm(ev.m.p_world[i] - target)) * 1e3
+    if level:
+        typo = joint_typo_level(robot, ev.base.T_world_base, p.q, float(target[2]), axis, CONTACT_OK_MM, TILT_OK_DEG)
+        err = abs(float(ev.m.p_world[i, 2] - target[2])) * 1e3
+        # Only its height and axis say anything: the change must bring the axis back too, not tilt it to reach the
+        # level (a pose hovering over its block is no typo of joint 2).
+        before = math.degrees(math.acos(float(np.clip(ev.m.R_world[i, :, 2] @ axis, -1.0, 1.0))))
+        if typo is not None and typo.residual_deg > max(LEVEL_TYPO_DEG, TYPO_SHARE * before):
+            return None
+    else:
+        typo = joint_typo_point(robot, ev.base.T_world_base, p.q, target, axis, CONTACT_OK_MM, TILT_OK_DEG)
+        err = float(np.linalg.norm(ev.m.p_world[i] - target)) * 1e3
     if typo is None or typo.residual_mm > min(CONTACT_OK_MM, TYPO_SHARE * err) or typo.residual_deg > TILT_OK_DEG:
         return None
     return typo
@@ -127,8 +149,10 @@ def diagnose_named(ev: Evidence, chosen: Judgement, i: int, points: Points) -> N
             return Named(f"it stands where {pose_label(*slot).removesuffix(' on')} is ({others[slot]:.1f} mm off): "
                          "probably recorded in the wrong slot",
                          "record it in its own slot or correct its tower and height", True)
-    target = chosen.expected_m[i]
-    typo = None if np.isnan(target[0]) else _typo(ev, p, i, target, axis)
+    level = chosen.by[i] == BY_LEVEL
+    target = (np.array([np.nan, np.nan, chosen.level_m[p.height]]) if level and p.k == ON else chosen.expected_m[i])
+    typo = None if np.isnan(target[2]) or (np.isnan(target[0]) and not level) else _typo(ev, p, i, target, axis,
+                                                                                            level)
     if typo is not None:
         return _typo_named(typo)
     turned = [f"its suction axis is {tilt:.1f} deg from the others'"] if tilt > TILT_FLAG_DEG else []
@@ -146,12 +170,14 @@ def _judgement(c: Consensus, i: int) -> Judgement:
 
 
 def where_text(ev: Evidence, c: Consensus, i: int) -> str:
-    """``15.9 mm from where the other points put it`` (``... (with the tower spacing and block size of lab_real)``
-    for a tower the layout placed)."""
+    """``15.9 mm from where the other points put it`` (for its tower's only contact: ``31.8 mm off the level where
+    the other towers put height 1 (...)``)."""
     j = _judgement(c, i)
-    layout = (f" (with the tower spacing and block size of {ev.base_label})" if j.by[i] == BY_LAYOUT
-              else "")
-    return f"{j.off_mm[i]:.1f} mm from where the other points put it{layout}"
+    if j.by[i] == BY_LEVEL:
+        p = ev.slots[i]
+        return (f"{j.off_mm[i]:.1f} mm off the level where the other towers put height {p[1] + 1} (one flat table, "
+                f"blocks of {ev.base_label})")
+    return f"{j.off_mm[i]:.1f} mm from where the other points put it"
 
 
 def named_text(ev: Evidence, c: Consensus, i: int, points: Points) -> str:
@@ -170,30 +196,35 @@ def refusal(ev: Evidence, c: Consensus, points: Points) -> str:
         n = diagnose_named(ev, c.chosen, i, points)
         out = (f"{slot_text(p)} is {where_text(ev, c, i)}; {n.what}. It is the only contact of tower {p.tower + 1}, "
                f"so nothing is written without it: {n.todo}")
-        if not n.explained and c.chosen.by[i] == BY_LAYOUT:
+        if not n.explained and c.chosen.by[i] == BY_LEVEL:
             out += f" (if tower {p.tower + 1} really stands there, run again with {accept_option(p)})"
         return out
     named = [f"{slot_text(points[i])} ({c.tried[i].off_mm[i]:.1f} mm off)" for i in c.wrong]
     towers = sorted({points[i].tower + 1 for i in c.wrong})
     more = f", or teach another height of tower {towers[0]} to decide" if len(towers) == 1 else ""
     return (f"the points cannot tell which of {' and '.join(named)} is wrong: leaving out any one of them leaves the "
-            f"others within {CONTACT_FLAG_MM:g} mm of where they and the layout of {ev.base_label} put "
-            f"them: re-record them{more}")
+            f"others consistent (within {CONTACT_FLAG_MM:g} mm of where they put each other, on one flat table, "
+            f"towers apart): re-record them{more}")
 
 
-def _check_text(ev: Evidence, j: Judgement, what: str, index: int, value: float, points: Points) -> str:
-    if what == "layout":
-        ps = [p for k, p in enumerate(points) if j.kept[k] and p.tower == index and p.k == ON]
-        accept = f" (if it really stands there: {accept_option(ps[0])})" if ps else ""
-        return (f"tower {index + 1} stands {value:.1f} mm from where the layout of {ev.base_label}, "
-                f"moved and turned onto the other towers, puts it{accept}")
+def _check_text(ev: Evidence, c: Check, points: Points) -> str:
+    what, index, value = c.what, c.index, c.value
+    if what == "level":
+        return (f"tower {index + 1} stands {abs(value):.1f} mm {'higher' if value > 0 else 'lower'} than the other "
+                "towers (one flat table)")
+    if what == "lean":
+        return (f"the suction axis at tower {index + 1} is {value:.1f} deg from the other towers' (more than "
+                f"{TOWER_TILT_DEG:g} deg)")
+    if what == "distinct":
+        return (f"towers {index + 1} and {c.other + 1} stand {value:.1f} mm apart (less than a block, "
+                f"{ev.base.block_size * 1e3:.1f} mm)")
     if what == "step":
         return (f"the step between levels puts the top level {value:.1f} mm from where the block size of "
                 f"{ev.base_label} puts it")
     if what == "point":
         return f"{slot_text(points[index])} is {value:.1f} mm from where the other points put it"
     if what == "tilt":
-        return f"the suction axis of {slot_text(points[index])} is {value:.1f} deg from the others'"
+        return f"the suction axis of {slot_text(points[index])} is {value:.1f} deg from its tower's other contacts'"
     if what == "above":
         return f"{slot_text(points[index])} is {value:.1f} mm off its tower's vertical line"
     if what == "approach":
@@ -203,12 +234,12 @@ def _check_text(ev: Evidence, j: Judgement, what: str, index: int, value: float,
 
 def unexplained(ev: Evidence, j: Judgement, points: Points) -> str:
     """Why the points ``j`` kept do not agree when no single point explains it ("" when they do)."""
-    said = [_check_text(ev, j, c.what, c.index, c.value, points) for c in j.checks if c.over and not c.soft]
+    said = [_check_text(ev, c, points) for c in j.checks if c.over and not c.soft]
     if not said:
         return ""
     more = f" and {len(said) - 3} more" if len(said) > 3 else ""
     return (f"no single point explains the disagreement ({'; '.join(said[:3])}{more}): check the tower/height labels "
-            f"and that {ev.base_label} is this station's calibration (robot base, tool, layout)")
+            f"and that {ev.base_label} is this station's calibration (robot base, tool, block size)")
 
 
 def accepted_lines(points: Points, accepted: Sequence[tuple[int, float]], base_label: str) -> list[str]:
@@ -223,5 +254,26 @@ def accepted_lines(points: Points, accepted: Sequence[tuple[int, float]], base_l
     return out
 
 
-__all__ = ["HOME_DEG", "Named", "accept_option", "accepted_lines", "diagnose_named", "named_text", "refusal",
-           "slot_text", "unexplained", "where_text"]
+def single_pose_lines(points: Points, single_pose: Sequence[tuple[int, int, float]]) -> list[str]:
+    """One line per tower whose place rests on one pose (:attr:`ur3hanoi.calibrate.result.CalibrationFit.
+    single_pose`): what nothing checks, and the pose that would."""
+    out = []
+    for t, i, lean in single_pose:
+        p = points[i]
+        tilt = (f"; its suction axis is {lean:.1f} deg from the other towers' (the tower's own tilt, or a wrong pose: "
+                "one pose cannot tell)" if lean > TILT_FLAG_DEG else "")
+        out.append(f"tower {t + 1} rests on one pose, {slot_text(p)}: nothing checks where it stands along the table "
+                   f"(a joint-1 offset would move it with nothing else changed){tilt}; record "
+                   f"{pose_label(t, p.height, ABOVE)} (or a second height of tower {t + 1}) to check it")
+    return out
+
+
+def note_lines(points: Points, accepted: Sequence[tuple[int, float]], single_pose: Sequence[tuple[int, int, float]],
+               base_label: str) -> list[str]:
+    """What a written calibration rests on without a check: the points taken on the student's word, the towers
+    resting on one pose."""
+    return [*accepted_lines(points, accepted, base_label), *single_pose_lines(points, single_pose)]
+
+
+__all__ = ["HOME_DEG", "LEVEL_TYPO_DEG", "Named", "accept_option", "accepted_lines", "diagnose_named", "named_text",
+           "note_lines", "refusal", "single_pose_lines", "slot_text", "unexplained", "where_text"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from ur3hanoi.cli.common import SYMLINK_NOTE, input_file, shown
 from ur3hanoi.cli.options import ACCEPT_HELP, TABLE_KEYS, UsageError, check_accept, slot
@@ -18,12 +19,14 @@ def add(sub: argparse._SubParsersAction) -> None:
                                    "everything else comes from --base. A gross error (the home pose, a pose in "
                                    "the wrong slot, a typo in one joint, copied entries) is found by what explains "
                                    "the most: the point whose removal leaves the others consistent with each "
-                                   "other, the block size and the base's layout; it is named and left out. When it "
-                                   "is its tower's only contact, or the points cannot tell which of two is wrong, "
-                                   "nothing is written (exit 2) and the message says which and what to do. The "
-                                   "report gives every point's deviation [mm] and the suspects worst first. Towers "
-                                   "and heights are numbered from 1. See `ur3hanoi.calibrate.taught` for the file "
-                                   "format.")
+                                   "other, one flat table, the block size and the tool pointing down; it is named "
+                                   "and left out. When it is its tower's only contact, or the points cannot tell "
+                                   "which of two is wrong, nothing is written (exit 2) and the message says which "
+                                   "and what to do. The towers stand wherever the points put them; a tower taught "
+                                   "at one pose is written, and the output says that nothing checks where it "
+                                   "stands along the table. The report gives every point's deviation [mm] and the "
+                                   "suspects worst first. Towers and heights are numbered from 1. See "
+                                   "`ur3hanoi.calibrate.taught` for the file format.")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--taught", metavar="FILE", help="taught-points YAML (units: deg|rad; points: [...])")
     src.add_argument("--from-table", metavar="FILE", help="lab-format table whose entries are the taught points")
@@ -46,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
     from ur3hanoi.audit import audit_taught
     from ur3hanoi.calibrate import fit_station, write_calibration
     from ur3hanoi.calibrate.taught import load_taught, taught_from_recorded
-    from ur3hanoi.calibrate.verdict import accepted_lines
+    from ur3hanoi.calibrate.verdict import note_lines
     from ur3hanoi.io.atomic import check_output
     from ur3hanoi.io.schema import Text
     from ur3hanoi.station.calibration import load_station
@@ -76,14 +79,15 @@ def run(args: argparse.Namespace) -> int:
     fit = fit_station(base, taught, name=args.name or printable(out.stem, name_spec.max_len), source=str(args.output),
                       accept=accept)
     report = audit_taught(fit, taught, args.key or "Q", shared)
-    print(json.dumps(report.to_json()) if args.json else report.text())
+    notes = note_lines(fit.points, fit.accepted, fit.single_pose, Path(args.base).as_posix())
+    print(json.dumps(_with_notes(report.to_json(), fit, notes)) if args.json else report.text())
     sys.stdout.flush()
     # An unsound fit is refused here with one error line (the report above names the suspects).
     write_calibration(out, fit, taught, base, taught_label=taught_label, base_label=Path(args.base).as_posix(),
                       inputs=inputs)
     for w in fit.warnings:
         print(f"ur3hanoi: warning: {w}", file=sys.stderr)
-    for line in accepted_lines(fit.points, fit.accepted, Path(args.base).as_posix()):
+    for line in notes:
         print(line, file=sys.stderr if args.json else sys.stdout)
     exact = " (exact fit: add points to check it)" if fit.dof == 0 else ""
     left_out = len(fit.points) - fit.n_used
@@ -91,3 +95,16 @@ def run(args: argparse.Namespace) -> int:
           f"{len(fit.points)} points ({left_out} suspect left out), residual rms {fit.rms_mm:.3f} mm, max "
           f"{fit.max_mm:.3f} mm{exact}; {len(fit.suspects)} suspect(s)", file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+def _with_notes(report: dict[str, Any], fit: Any, notes: list[str]) -> dict[str, Any]:
+    """The audit's JSON with what the calibration rests on unchecked: ``single_pose`` (per tower resting on one
+    pose: its number from 1, the pose's field, the pose that would check it) and ``notes`` (the lines printed)."""
+    from ur3hanoi.station.grid import ABOVE, pose_label
+
+    report["single_pose"] = [{"tower": t + 1, "pose": fit.points[i].where,
+                              "check_with": pose_label(t, fit.points[i].height, ABOVE),
+                              "axis_from_other_towers_deg": None if lean != lean else round(float(lean), 3)}
+                             for t, i, lean in fit.single_pose]
+    report["notes"] = notes
+    return report

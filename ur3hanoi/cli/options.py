@@ -108,8 +108,8 @@ def slot(text: str) -> tuple[int, int]:
     return int(values[0]), int(values[1])  # type: ignore[arg-type]
 
 
-ACCEPT_HELP = ("accept the contact pose taught at tower T height H on your word (repeatable): its tower is placed "
-               "where it says even when the other points and the base's layout put it elsewhere (a tower that "
+ACCEPT_HELP = ("accept the contact pose taught at tower T height H on your word (repeatable): it is never left out "
+               "and its tower is placed where it says even off the other towers' level or axis (a tower that "
                "really stands apart); the output says so")
 """``--accept``'s help, one text for ``calibrate`` and ``teach``."""
 

@@ -105,6 +105,31 @@ def station_options(args: argparse.Namespace, default_calibration: str, report: 
             "video": Path(args.video) if args.video else None}
 
 
+class ReportStdout:
+    """Standard output for a station's JSON report alone (``station > report.json`` is JSON): inside, whatever
+    else writes to file descriptor 1 (rospy's info handler, DDS and other C libraries, child processes) goes to
+    stderr; the value of ``with`` prints a report to the real stdout."""
+
+    def __enter__(self) -> Callable[[str], None]:
+        import os
+
+        sys.stdout.flush()
+        self._fd = os.dup(1)
+        os.dup2(2, 1)
+        self._file = os.fdopen(os.dup(self._fd), "w")
+        return lambda text: print(text, file=self._file, flush=True)
+
+    def __exit__(self, *exc: object) -> None:
+        import os
+
+        try:
+            self._file.close()
+        finally:
+            sys.stdout.flush()
+            os.dup2(self._fd, 1)
+            os.close(self._fd)
+
+
 def stopped_line(command: str, report: dict[str, Any], extra: str = "") -> str:
     """``COMMAND stopped: N commands executed, M refused; EXTRA`` (``extra`` ends with the report file); with the
     UR driver's interface ``N goals accepted, M rejected``."""

@@ -9,7 +9,6 @@ fault exits with 3. Heavy imports (MuJoCo, rospy) happen only when a command run
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -87,19 +86,9 @@ def _run_station(args: argparse.Namespace) -> int:
     driver.program_times(args)  # a contradiction in the program options: one line before any work
     report_file = remote.check_station_outputs(args, DEFAULT_CALIBRATION)  # before any work
     node = _node(args, report_file)
-    # Standard output carries only the JSON report: whatever else writes to file descriptor 1 (rospy's info
-    # handler, C libraries) goes to stderr while the node runs.
-    sys.stdout.flush()
-    report_fd = os.dup(1)
-    os.dup2(2, 1)
-    try:
-        with os.fdopen(os.dup(report_fd), "w") as report_out:
-            node.report_out = lambda text: print(text, file=report_out, flush=True)
-            report = node.run()
-    finally:
-        sys.stdout.flush()
-        os.dup2(report_fd, 1)
-        os.close(report_fd)
+    with remote.ReportStdout() as report_out:
+        node.report_out = report_out
+        report = node.run()
     if report_file is not None and args.driver == "ur":
         print(remote.stopped_line("ros-station", report, f"report {args.report}"), file=sys.stderr, flush=True)
     elif report_file is not None:

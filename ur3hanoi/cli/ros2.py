@@ -8,6 +8,7 @@ exit code 2; a suction fault exits with 3. Heavy imports (MuJoCo, Cyclone DDS) h
 from __future__ import annotations
 
 import argparse
+import sys
 
 from ur3hanoi.cli import driver, remote
 
@@ -103,18 +104,20 @@ def _run_station(args: argparse.Namespace) -> int:
         import_rclpy()  # say what is missing before loading the world
 
         stop, resume = driver.program_times(args)
-        report = Ros2DriverStation(Ros2DriverOptions(**fields, speed_scaling=args.speed_scaling,
-                                                     distro=_distro(args), network=args.network,
-                                                     domain_id=args.domain_id, program_stop_at_s=stop,
-                                                     program_resume_at_s=resume)).run()
+        with remote.ReportStdout() as report_out:
+            report = Ros2DriverStation(Ros2DriverOptions(**fields, speed_scaling=args.speed_scaling,
+                                                         distro=_distro(args), network=args.network,
+                                                         domain_id=args.domain_id, program_stop_at_s=stop,
+                                                         program_resume_at_s=resume), report_out=report_out).run()
     else:
         from ur3hanoi.interface.ros2.server import Ros2Server, Ros2ServerOptions
 
         options = Ros2ServerOptions(**fields, timing=args.timing, convention=args.convention, network=args.network,
                                     domain_id=args.domain_id)
-        report = Ros2Server(options).run()
+        with remote.ReportStdout() as report_out:
+            report = Ros2Server(options, report_out=report_out).run()
     if report_file is not None:
-        print(remote.stopped_line("ros2-station", report, f"report {args.report}"), flush=True)
+        print(remote.stopped_line("ros2-station", report, f"report {args.report}"), file=sys.stderr, flush=True)
     return 0
 
 

@@ -261,10 +261,10 @@ def _finish(args: argparse.Namespace, base: Station, base_label: str, taught: Ta
     """Fit, print the audit, write the calibration and the table key, say how accurate it is and what to run."""
     from ur3hanoi.audit import audit_taught
     from ur3hanoi.calibrate import fit_station, write_calibration
-    from ur3hanoi.calibrate.verdict import accepted_lines
+    from ur3hanoi.calibrate.verdict import note_lines
     from ur3hanoi.cli.tables import write_key
     from ur3hanoi.errors import TaughtPointsError
-    from ur3hanoi.teach.feedback import feedback
+    from ur3hanoi.teach.feedback import BY_POINTS, feedback
 
     if not taught.points:
         raise TaughtPointsError(f"{shown(taught.path)}: no point recorded yet: nothing to calibrate",
@@ -276,14 +276,15 @@ def _finish(args: argparse.Namespace, base: Station, base_label: str, taught: Ta
     print(audit_taught(fit, points).text())
     write_calibration(station_out, fit, points, base, taught_label=taught.path.as_posix(), base_label=base_label,
                       inputs=[input_file(args.base), taught.path])
-    for line in accepted_lines(fit.points, fit.accepted, base_label):
+    for line in note_lines(fit.points, fit.accepted, fit.single_pose, base_label):
         print(line)
     fb = feedback(base, points, base_label, accept)
-    worst = max((r.off_mm for r in fb.rows if not math.isnan(r.off_mm) and fit.used[r.index]), default=math.nan)
+    checked = [r.off_mm for r in fb.rows if r.by == BY_POINTS and not math.isnan(r.off_mm) and fit.used[r.index]]
     exact = ("an exact fit (one point per tower): each tower origin is where its taught pose put it, as accurate "
              "as that pose" if fit.dof == 0 else f"residual rms {fit.rms_mm:.2f} mm over {fit.n_used} points")
-    print(f"wrote {shown(station_out)}: {exact}; every point within {worst:.1f} mm of where the others put it; "
-          f"{len(fit.suspects)} suspect(s)")
+    within = (f"every point the others check within {max(checked):.1f} mm of where they put it" if checked else
+              "no point is checked by the others")
+    print(f"wrote {shown(station_out)}: {exact}; {within}; {len(fit.suspects)} suspect(s)")
     key = args.key or "real_pos"
     if args.table is not None:
         print(write_key(str(station_out), key, args.table))

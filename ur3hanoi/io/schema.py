@@ -180,6 +180,8 @@ class _Validator:
             if not spec.accepts(value):
                 raise self.fail(path, value, spec.expected())
         elif isinstance(spec, Nullable):
+            if isinstance(spec.item, Number) and value is not None and not spec.item.accepts(value):
+                raise self.fail(path, value, spec.expected())  # a leaf: say that null is allowed too
             if value is not None:
                 self.check(value, spec.item, path)
         elif isinstance(spec, ListOf):

@@ -67,11 +67,14 @@ class RobotDescription:
         link_radius: radius [m] of the link shapes of a generated model: base/shoulder, upper arm/forearm, wrists.
         control_rate_hz: the controller's servo rate [Hz]: 125 on CB3, 500 on e-Series (the official drivers'
             ``loop_hz`` / ``update_rate``; URCL ``rtde_client.h``).
-        course_suction_io: the course's suction wiring on this arm: (digital output switching the vacuum, digital
+        course_suction_io: the course's suction wiring on this arm: (digital output switching the cup, digital
             input of the vacuum switch, analog input of the vacuum sensor), as ``set_io`` / ``io_states`` pins.
-            UR3: the lab manual's feedback on Digital Input 0 and Analog Input 0; its output is named nowhere in
-            the course material: digital output 0 is **unverified** (the course message's field is ``io_0``).
+            UR3 (ECE 470): the course's ``ur3_driver.cpp`` maps ``io_0`` to ``set_digital_out(0, ...)``: digital
+            output 0; the lab manual's feedback on Digital Input 0 and Analog Input 0.
             UR3e: UMD ENME480's bridge switches digital output 1 and reads digital input 0, analog input 0.
+        course_vacuum_generator: the ``set_io`` pin of the output that switches the cell's vacuum generator, on for
+            the whole session, or None (UR3: the cup's output is all there is). UR3e: ENME480's bridge
+            (``ur3e_mrc_enme480_ctrl.cpp``) switches pin 12 (configurable output 4) on at start, off on exit.
     """
 
     name: str
@@ -91,6 +94,7 @@ class RobotDescription:
     link_radius: tuple[float, float, float] = (0.045, 0.035, 0.03)
     control_rate_hz: float = 125.0
     course_suction_io: tuple[int, int, int] = (0, 0, 0)
+    course_vacuum_generator: int | None = None
 
 
 _SPEED = (math.pi,) * 3 + (2 * math.pi,) * 3  # 180 deg/s joints 1-3, 360 deg/s wrists (both datasheets)
@@ -125,6 +129,7 @@ UR3E = RobotDescription(
             (0.0, 0.0, -0.02)),
     shoulder_offset=0.12, elbow_offset=0.093, link_radius=(0.046, 0.035, 0.0315),
     control_rate_hz=E_SERIES_CONTROL_RATE_HZ, course_suction_io=(1, 0, 0),
+    course_vacuum_generator=12,
 )
 
 ROBOTS: dict[str, RobotDescription] = {r.name: r for r in (UR3, UR3E)}

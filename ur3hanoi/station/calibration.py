@@ -305,7 +305,7 @@ def parse_station(data: Any, source: str = "<memory>") -> Station:
         limits=limits, tool=tool_offset, tool_yaw=tool_yaw, block_size=block_size, contact_depth=depth,
         tower_origins=origins, height_step=_vec3(grid["height_step"]), n_heights=n_heights,
         approach=float(grid["approach"]), source=source, suction=suction, robot=arm,
-        wiring=parse_wiring(data.get("io"), arm),
+        wiring=parse_wiring(data.get("io"), arm, source),
     )
     validate(station)
     return station

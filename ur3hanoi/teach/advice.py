@@ -3,11 +3,12 @@
 1. **Required**: the fit needs a contact on every tower. Tower by tower, the one with the blocks (``start``) is
    taught on its top block (the ones below are covered), the others on a block on the table (height 1) for a
    stacked station; a flat station's first row on every tower.
-2. **Optional**, once every tower has one: with one contact per tower no point can be checked by the others (each
-   alone fixes its tower: the audit calls it ``unchecked``, by :func:`ur3hanoi.calibrate.grid_fit.removable`).
-   Next is the slot that makes the most points checkable; then the tower with the fewest points; then the height
-   farthest from the tower's taught ones (the longest lever for the step between levels). With every tower taught
-   at two heights every point is checked.
+2. **A checked set**, once every tower has one: a tower resting on one pose may stand anywhere along the table (a
+   joint-1 offset moves it unseen: issue 37), so each such tower is named next for a second height, until every
+   tower is checked by a second pose (``f`` writes before that, saying which towers rest on one pose). Then, as
+   options, the slot that makes the most points checkable (:func:`ur3hanoi.calibrate.grid_fit.removable`; the
+   audit calls the others ``unchecked``); then the tower with the fewest points; then the height farthest from the
+   tower's taught ones (the longest lever for the step between levels).
 
 A slot skipped (``s``) is not named again in the session.
 """
@@ -81,17 +82,24 @@ def next_pose(base: Station, slots: Sequence[Slot], start: int, skipped: Collect
     if not candidates:
         return None
 
-    def rank(c: tuple[int, int]) -> tuple[int, int, int, int, int]:
+    single = [t for t in range(base.n_towers) if sum(1 for tt, _, _ in slots if tt == t) == 1]
+
+    def rank(c: tuple[int, int]) -> tuple[bool, int, int, int, int, int]:
         t, h = c
         gain = _checkable(base, [*slots, (t, h, ON)]) - n_now
         on_tower = [hh for tt, hh in taught_on if tt == t]
         lever = min(abs(h - hh) for hh in on_tower) if on_tower else 0
-        return (-gain, len(on_tower), -lever, t, h)
+        return (t not in single, -gain, len(on_tower), -lever, t, h)
 
     t, h = min(candidates, key=rank)
-    gain = -rank((t, h))[0]
+    gain = -rank((t, h))[1]
     n = len(slots)
-    if n_now == n:
+    if t in single:
+        rest = [u for u in single if u != t]
+        more = f" (then tower(s) {_towers(rest)})" if rest else ""
+        why = (f"tower {t + 1} rests on one pose: nothing checks where it stands along the table (a joint-1 offset "
+               f"would move it unseen); a second height checks it{more}. f writes without it, with that note")
+    elif n_now == n:
         why = "optional: every point is checked by the others; more points average the recording noise"
     elif gain > 0:
         why = (f"optional: {n - n_now} of the {n} points cannot be checked yet (each alone fixes its tower or the step "
@@ -99,7 +107,7 @@ def next_pose(base: Station, slots: Sequence[Slot], start: int, skipped: Collect
     else:
         why = (f"optional: {n - n_now} of the {n} points cannot be checked yet; every tower taught at two heights "
                "checks them all, and this is a step towards it")
-    return Advice(t, h, False, why + _where(base, t, h, start))
+    return Advice(t, h, False, why + _where(base, t, h, start))  # optional: f writes without it
 
 
 __all__ = ["Advice", "next_pose", "required_height"]

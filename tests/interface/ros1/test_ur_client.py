@@ -14,6 +14,7 @@ import pytest
 
 from tests.support import SUPPORT
 from tests.support.ros_support import final_slots, free_port, requires_ros, ros_env, roscore, run, station, ur3hanoi_cmd
+from ur3hanoi.io.resources import station_file
 
 pytestmark = [pytest.mark.ros, requires_ros]
 
@@ -52,6 +53,42 @@ def test_a_solve_then_a_dropped_block_halt_through_the_ur_driver_interface(tmp_p
     assert len(report["halts"]) == 1 and report["halts"][0]["cycles"] >= 1 and report["goals"]["canceled"] == 1
     assert report["goals"]["received"] == sent and [e["running"] for e in report["program"]] == [False]  # refused
     assert report["final"]["at_home"] and not report["final"]["suction_on"]
+
+
+def test_ctrl_c_mid_solve_leaves_every_output_off_and_the_station_reports_on_stdout(tmp_path):
+    """A cell with a vacuum generator (pin 12, as ENME480's UR3e): the solve switches it on first; Ctrl-C at the
+    start of move 2 stops the arm and switches every output off. The station runs without --report: its
+    stdout is its JSON report alone, written when SIGTERM stops it."""
+    env = ros_env(free_port(), tmp_path)
+    cal = tmp_path / "generator.yaml"
+    cal.write_text(station_file("lab_sim").read_text() + "io:\n  vacuum_generator_output: 12\n")
+    with roscore(env), station(env, tmp_path, "--driver", "ur", "--blocks", "2", "--calibration", str(cal),
+                               report=None) as st:
+        proc = subprocess.Popen(ur3hanoi_cmd("ros-solve", "--driver", "ur", "--start", "1", "--end", "3", "--blocks",
+                                             "2", "--calibration", str(cal)), env=env, text=True,
+                                stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                start_new_session=True)
+        try:
+            said = []
+            assert proc.stdout is not None
+            for line in proc.stdout:  # the solve's progress, until move 2 starts
+                said.append(line)
+                if line.startswith("move 2/3"):
+                    proc.send_signal(signal.SIGINT)
+                    break
+            out, err = proc.communicate(timeout=30)
+        finally:
+            stop(proc)
+        report = st.stop_json(signal.SIGTERM)
+    assert proc.returncode == 130 and err.strip().splitlines()[-1] == "ur3hanoi ros-solve: interrupted", \
+        "".join(said) + out + err
+    assert said[1].startswith("vacuum generator on: configurable output 4 (set_io pin 12)"), said
+    calls = [(c["pin"], c["state"]) for c in report["io_calls"]]
+    assert calls[0] == (12, 1.0) and calls[-1] == (12, 0.0), calls
+    assert report["final"]["digital_outputs_on"] == [] and not report["final"]["suction_on"]
+    # Ctrl-C lands in the release of move 1 or the approach of move 2 (the line is printed between them): a goal
+    # running then is canceled (the CPU-clock tests pin that case down); none is left running
+    assert report["goals"]["canceled"] <= 1 and not report["final"]["goal_active"], (report["goals"], calls, err)
 
 
 def fake_driver(env: dict[str, str], mode: str, log: Path) -> subprocess.Popen[str]:

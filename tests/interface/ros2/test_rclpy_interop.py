@@ -38,12 +38,13 @@ def _station(tmp_path: Path, station_args: str = "") -> str:
 
 
 def _station_script(tmp_path: Path, launch: str, peer: str) -> str:
-    """Start ``launch`` (a background shell line writing ``tmp_path/st.out``), wait for its ready line, run ``peer``,
+    """Start ``launch`` (a background shell line writing ``tmp_path/st.out`` and ``st.err``, where its ready line
+    goes), wait for its ready line, run ``peer``,
     stop the station with SIGINT; exit with the peer's code."""
     return f"""
 {launch}
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 {peer}
 CODE=$?
 kill -INT $ST; wait $ST; echo "station exit $?" >&2
@@ -97,6 +98,7 @@ def test_graph_names_the_nodes_endpoints(rclpy_env: PeerEnv, graph: dict[str, An
 # ros_discovery_info under the all-zero participant gid instead of its own.
 _GID_ZERO_NODE = """
 import signal
+import sys
 import time
 from cyclonedds.core import Policy, Qos
 from cyclonedds.pub import DataWriter
@@ -114,7 +116,7 @@ info.write(ParticipantEntitiesInfo(gid=Gid([0] * 16), node_entities_info_seq=[No
     node_namespace="/", node_name="ur3hanoi_station",
     writer_gid_seq=[Gid(list(w.guid.bytes)) for w in (position, gripper)])]))
 signal.signal(signal.SIGINT, signal.default_int_handler)  # a background job of a script starts with SIGINT ignored
-print("ros2-station: ready", flush=True)
+print("ros2-station: ready", file=sys.stderr, flush=True)
 try:
     while True:
         position.write(PositionUR3e(position=[0.0] * 6, is_ready=True))

@@ -61,14 +61,15 @@ def test_default_dds_configuration_is_loopback_only() -> None:
 @pytest.mark.dds
 @requires_netns
 def test_ros2_solve_solves_on_the_ur3e_station_over_dds(tmp_path: Path) -> None:
-    report = tmp_path / "report.json"
+    """Without --report the station's stdout is its JSON report alone, written when SIGTERM stops it."""
+    report = tmp_path / "st.out"
     script = f"""
-$UR3HANOI ros2-station --timing honest --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
+$UR3HANOI ros2-station --timing honest > {report} 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 $UR3HANOI ros2-solve --start 1 --end 3 --v 4 --a 4 --json
 CODE=$?
-kill -INT $ST; wait $ST; echo "station exit $?" >&2
+kill -TERM $ST; wait $ST; echo "station exit $?" >&2
 exit $CODE
 """
     result = in_netns(script, 240.0, REPO)
@@ -81,7 +82,7 @@ exit $CODE
     assert r["final"]["at_home"] and not r["final"]["suction_on"]
     assert r["commands"]["rejected"] == 0 and r["transport"]["network"] == "loopback"
     assert r["suction"]["profile"] == "real"
-    assert "ready on ROS_DOMAIN_ID 0 (loopback): ur3e_sim" in (tmp_path / "st.out").read_text()
+    assert "ready on ROS_DOMAIN_ID 0 (loopback): ur3e_sim" in (tmp_path / "st.err").read_text()
 
 
 @pytest.mark.dds
@@ -92,7 +93,7 @@ def test_bridge_timing_and_halt_on_a_missing_block_over_dds(tmp_path: Path) -> N
     script = f"""
 $UR3HANOI ros2-station --remove-block 3 --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 $UR3HANOI ros2-solve --start 1 --end 3 --json
 CODE=$?
 kill -INT $ST; wait $ST; echo "station exit $?" >&2
@@ -219,7 +220,7 @@ def test_absurd_commands_over_dds_are_refused_and_sigterm_stops_the_station_clea
     script = f"""
 $UR3HANOI ros2-station --timing honest --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 {PUBLISHER} '{json.dumps(bad)}' || exit 91
 kill -USR1 $ST; sleep 0.5; cp {report} {tmp_path}/snap.json
 {PUBLISHER} '{json.dumps(good)}' || exit 92
@@ -257,7 +258,7 @@ def test_a_1_khz_command_flood_over_dds_stays_bounded_and_sigint_stops_the_stati
     script = f"""
 $UR3HANOI ros2-station --report {report} > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 {PUBLISHER} --flood 1000 {seconds} '{json.dumps(fields)}' || exit 91
 kill -INT $ST; wait $ST; echo "station exit $?" >&2
 """
@@ -304,7 +305,7 @@ def test_remove_block_and_spawn_over_dds_with_frames_rendered(tmp_path: Path) ->
 $UR3HANOI ros2-station --timing honest --blocks 1 --frames {frames} --report {report} \\
   > {tmp_path}/st.out 2> {tmp_path}/st.err &
 ST=$!
-wait_ready {tmp_path}/st.out || exit 90
+wait_ready {tmp_path}/st.err || exit 90
 {PUBLISHER} --int ur3hanoi/remove_block 0 1 || exit 91
 {solve} > {tmp_path}/halt.json; echo "halt exit $?" >&2
 kill -USR1 $ST; sleep 0.5; cp {report} {tmp_path}/snap.json

@@ -37,7 +37,7 @@ def _script(env: PeerEnv, tmp_path: Path, station_args: str, *peers: str, backgr
     ``peer<i>.json``), stop the background process and the station with SIGINT; exit with the first failing peer's
     code."""
     lines = [f"{env.station_prefix()} $UR3HANOI ros2-station --driver ur {station_args} --report {tmp_path}/report.json"
-             f" > {tmp_path}/st.out 2> {tmp_path}/st.err &", "ST=$!", f"wait_ready {tmp_path}/st.out || exit 90",
+             f" > {tmp_path}/st.out 2> {tmp_path}/st.err &", "ST=$!", f"wait_ready {tmp_path}/st.err || exit 90",
              "CODE=0"]
     if background:
         lines += [f"{background} > {tmp_path}/bg.out 2> {tmp_path}/bg.err &", "BG=$!"]
@@ -159,6 +159,10 @@ def test_enme480_bridge_on_the_driver_interface_solves_one_block(tmp_path: Path)
     assert [(b["block"], b["tower"], b["height"]) for b in r["final"]["blocks"]] == [(1, 3, 1)]
     assert r["final"]["at_home"] and not r["final"]["suction_on"]
     assert r["goals"]["rejected"] == 0 and r["goals"]["aborted"] == 0 and r["goals"]["succeeded"] == 10
+    # the bridge's start: the tool voltage 12 V, then the vacuum generator on pin 12 (without it the cup would not
+    # pull on ur3e_sim, wired as ENME480's cells)
+    calls = [(c["fun"], c["pin"], c["state"]) for c in r["io_calls"]]
+    assert calls[:2] == [(4, 17, 12.0), (1, 12, 1.0)], calls
 
 
 if __name__ == "__main__":

@@ -4,8 +4,10 @@ client's timeout under the speed slider."""
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 from functools import cache
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +19,8 @@ from ur3hanoi.interface.urdriver.client import DriverGoalError, DriverState
 from ur3hanoi.interface.urdriver.facts import ErrorCode
 from ur3hanoi.interface.urdriver.loopback import LoopbackTransport
 from ur3hanoi.interface.urdriver.solve import DriverSolveConfig, run_driver_solve
+from ur3hanoi.io.resources import station_file
+from ur3hanoi.lifecycle import Terminated
 from ur3hanoi.plan import Plan, PlanConfig, plan_solve
 
 
@@ -42,13 +46,34 @@ def slots(st) -> dict[int, tuple[int | None, int | None]]:
     return {b["block"]: (b["tower"], b["height"]) for b in st.report()["final"]["blocks"]}
 
 
-def test_a_three_block_solve_runs_the_plan_in_its_own_time():
-    result, st, lines = solve(3)
+def wired(tmp_path: Path, generator: str = "12") -> str:
+    """lab_sim with a vacuum generator output, as a UR3e cell of ENME480 is wired (pin 12, the cup on DO 0 here)."""
+    path = tmp_path / "wired.yaml"
+    path.write_text(station_file("lab_sim").read_text() + f"io:\n  vacuum_generator_output: {generator}\n")
+    return str(path)
+
+
+def io_calls(st) -> list[tuple[int, float]]:
+    return [(c["pin"], c["state"]) for c in st.report()["io_calls"]]
+
+
+def test_a_three_block_solve_runs_the_plan_in_its_own_time(tmp_path):
+    result, st, lines = solve(3, calibration=wired(tmp_path))
     p = plan(3)
     assert slots(st) == {1: (3, 1), 2: (3, 2), 3: (3, 3)}
     assert result.goals == 15 and result.approach_s == 0.0
-    # One progress line per move, as the course interface's solve prints them.
-    assert lines == [f"move {i + 1}/7: {describe_move(mv)}" for i, mv in enumerate(p.moves)]
+    # The generator first (before anything moves), then one progress line per move, as the course interface's
+    # solve prints them.
+    assert lines == ["vacuum generator on: configurable output 4 (set_io pin 12) (calibration "
+                     "io.vacuum_generator_output)"] + [f"move {i + 1}/7: {describe_move(mv)}"
+                                                       for i, mv in enumerate(p.moves)] + \
+        ["vacuum generator off: configurable output 4 (set_io pin 12)"]
+    # ... and every output off at the end, the cup's first, as the bridge leaves the cell (the station logs the
+    # last calls in its next cycle)
+    st.cycle()
+    calls = io_calls(st)
+    assert calls[0] == (12, 1.0) and calls[-2:] == [(0, 0.0), (12, 0.0)] and calls.count((0, 1.0)) == 7
+    assert st.report()["final"]["digital_outputs_on"] == []
     # The executed time is the plan's: one control cycle per goal more, the dwells as planned.
     assert result.executed_s == pytest.approx(p.duration_s, rel=0.02)
     report = st.report()
@@ -180,6 +205,81 @@ def test_a_hand_recorded_tables_plan_runs_too():
     tr.connect()
     result = run_driver_solve(tr, p, st.station.wiring)
     assert slots(st) == {1: (3, 1)} and result.executed_s == pytest.approx(p.duration_s, rel=0.02)
+
+
+@pytest.mark.parametrize(("client_generator", "named"), [
+    (None, r"the calibration names no vacuum generator output \(io\.vacuum_generator_output\): if the cell switches "
+           r"its generator from the robot \(ENME480's UR3e: set_io pin 12, configurable output 4\), write that pin "
+           r"into io\.vacuum_generator_output$"),
+    (11, r"with the vacuum generator's configurable output 3 \(set_io pin 11\) \(io\.vacuum_generator_output\) on "
+         r"since the start: is that the generator's pin"),
+])
+def test_without_the_cells_generator_on_the_cup_does_not_pull_and_the_first_grasp_halts_naming_the_pin(
+        tmp_path, client_generator, named):
+    """The cell switches its vacuum generator on pin 12; the client's calibration names no generator, or pin 11."""
+    st = station(n_blocks=1, calibration=wired(tmp_path))
+    tr = LoopbackTransport(st)
+    tr.connect()
+    client = replace(st.station.wiring, generator=client_generator)
+    with pytest.raises(SuctionFaultError) as err:
+        run_driver_solve(tr, plan(1), client)
+    message = str(err.value)
+    assert re.match(r"suction fault in move 1/1: no vacuum at the grasp of green block 1 at tower 1 height 1 \(DI0=0, "
+                    r"AI0=1\.0\d V, (DO11=1, )?DO0=1\); halted, suction off, arm returned home\. The cup's digital "
+                    r"output 0 \(io\.suction_output\) is on but the vacuum sensor reads no vacuum", message), message
+    assert re.search(named, message), message
+    # nothing was picked (the block stands where it was spawned), the arm is home, every output is off
+    st.cycle()
+    assert slots(st)[1] == (1, 1) and st.report()["final"]["at_home"]
+    assert st.report()["final"]["digital_outputs_on"] == [] and not st.world.suction_on
+
+
+class StopMidCarry(LoopbackTransport):
+    """0.2 s into the first carry (the block held): Ctrl-C, SIGTERM (raised as :class:`Terminated`) or the arm held
+    against an obstacle (the controller aborts the goal: an error)."""
+
+    def __init__(self, station, stop) -> None:
+        super().__init__(station)
+        self.stop, self.held_cycles = stop, 0
+
+    def wait(self, timeout_s: float) -> None:
+        super().wait(timeout_s)
+        if self._sent == 2 and self.station.output.io.digital_in[0] and self.held_cycles < 25:
+            self.held_cycles += 1
+            if self.held_cycles == 25:
+                self.stop(self.station)
+
+
+def _hold(st) -> None:
+    st.on_hold(3.0)
+
+
+def _raise(kind):
+    def stop(_st) -> None:
+        raise kind
+    return stop
+
+
+@pytest.mark.parametrize(("stop", "raised"), [(_raise(KeyboardInterrupt), KeyboardInterrupt),
+                                              (_raise(Terminated), Terminated), (_hold, DriverGoalError)],
+                         ids=["ctrl-c", "sigterm", "error"])
+def test_every_way_out_mid_carry_stops_the_arm_and_switches_every_output_off(tmp_path, stop, raised):
+    st = station(n_blocks=1, calibration=wired(tmp_path))
+    tr = StopMidCarry(st, stop)
+    tr.connect()
+    lines: list[str] = []
+    with pytest.raises(raised):
+        run_driver_solve(tr, plan(1), st.station.wiring, log=lines.append)
+    # what the way out did, said (an aborted goal has ended and the error path has switched the cup off already)
+    assert lines[-1] == "stopping: " + ("configurable output 4 (set_io pin 12) off" if raised is DriverGoalError else
+                                        "the running goal canceled, digital output 0 off, configurable output 4 "
+                                        "(set_io pin 12) off")
+    st.cycle()
+    report = st.report()
+    assert tr.held_cycles == 25 and io_calls(st)[0] == (12, 1.0) and io_calls(st)[-2:] == [(0, 0.0), (12, 0.0)]
+    assert report["goals"]["canceled" if raised is not DriverGoalError else "aborted"] == 1
+    assert report["final"]["digital_outputs_on"] == [] and not st.world.suction_on
+    assert not st.report()["final"]["goal_active"] and float(np.max(np.abs(st.world.qd))) < 1e-2  # stopped
 
 
 def test_a_stopped_robot_program_refuses_the_solve_before_any_goal():

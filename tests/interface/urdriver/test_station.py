@@ -165,6 +165,31 @@ def test_io_states_read_the_suction_on_the_calibrations_pins(tmp_path):
     assert st.output.io.analog_in[1][1] == pytest.approx(profile.ain0_free, abs=0.05)
 
 
+def test_the_cup_pulls_only_while_the_cells_vacuum_generator_is_on(tmp_path):
+    """A cell wired as ENME480's UR3e: the generator on pin 12 (configurable output 4), the cup on its own output."""
+    from ur3hanoi.io.resources import station_file
+
+    cal = tmp_path / "generator.yaml"
+    cal.write_text(station_file("lab_sim").read_text() + "io:\n  vacuum_generator_output: 12\n")
+    st, tr = fresh(calibration=str(cal))
+    profile = st.world.cup.profile
+    tr.set_io(FUN_SET_DIGITAL_OUT, 0, 1.0)  # the cup's output alone: open to the air, no vacuum
+    tr.wait(0.0)
+    tr.wait(0.0)
+    assert st.output.io.digital_out[0] and not st.world.suction_on
+    assert st.output.io.analog_in[0][1] == pytest.approx(profile.ain0_off, abs=0.05)
+    tr.set_io(FUN_SET_DIGITAL_OUT, 12, 1.0)
+    tr.wait(0.0)
+    tr.wait(0.0)
+    assert st.world.suction_on and st.output.io.analog_in[0][1] == pytest.approx(profile.ain0_free, abs=0.05)
+    assert st.report()["final"]["digital_outputs_on"] == [0, 12]
+    assert st.report()["driver"]["wiring"]["vacuum_generator_output"] == 12
+    tr.set_io(FUN_SET_DIGITAL_OUT, 12, 0.0)  # the generator off: the vacuum goes, whatever the cup's output says
+    tr.wait(0.0)
+    tr.wait(0.0)
+    assert not st.world.suction_on and st.report()["final"]["digital_outputs_on"] == [0]
+
+
 def test_a_stopped_robot_program_preempts_the_goal_and_refuses_new_ones(home):
     st, tr = fresh()
     h = tr.send_goal(goal(home + 0.5, 2.0, home))

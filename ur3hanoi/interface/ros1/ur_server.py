@@ -129,7 +129,7 @@ class RosDriverServer(RosStation, DriverStation):
     def _ready_detail(self) -> str:
         opts = self.options
         return (f"the UR driver's interface ({opts.profile.name}) at {1.0 / self.world.config.period_s:g} Hz, speed "
-                f"slider {100 * opts.speed_scaling:g} %, suction on DO{self.station.wiring.output}")
+                f"slider {100 * opts.speed_scaling:g} %, {self.station.wiring.describe()}")
 
     def _open(self, rospy: Any) -> Callable[[], None]:
         import importlib

@@ -102,8 +102,11 @@ class Ros2Server(CourseStation):
 
     Args:
         options: what to run.
-        out: where the ready line and the report go (default: print to stdout, flushed).
+        out: where the ready line goes (default: print to stderr, flushed), and the report when ``report_out``
+            is not given.
         log: where log lines go (default: stderr).
+        report_out: where the JSON report goes without ``options.report`` (default: ``out`` when given, else
+            print to stdout, flushed): stdout carries the report alone.
     """
 
     options: Ros2ServerOptions
@@ -112,16 +115,19 @@ class Ros2Server(CourseStation):
                                            "spawn": TOPIC_SPAWN, "remove": TOPIC_REMOVE}
 
     def __init__(self, options: Ros2ServerOptions, out: Callable[[str], None] | None = None,
-                 log: Callable[[str], None] | None = None) -> None:
+                 log: Callable[[str], None] | None = None,
+                 report_out: Callable[[str], None] | None = None) -> None:
         from ur3hanoi.interface.ros2.dds import domain_id_from_env
 
         if options.timing not in TIMINGS:
             raise InputError(f"timing {options.timing!r} is invalid: expected one of {', '.join(TIMINGS)}")
         if options.convention not in ("course", "controller"):
             raise InputError(f"convention {options.convention!r} is invalid: expected course or controller")
-        printed = out if out is not None else (lambda s: print(s, flush=True))
+        # stdout carries the JSON report alone (``station > report.json``); the ready line goes with the logs
+        said = out if out is not None else (lambda s: print(s, file=sys.stderr, flush=True))
         self._log_line = log if log is not None else (lambda s: print(s, file=sys.stderr, flush=True))
-        super().__init__(options, printed, printed)
+        report = report_out if report_out is not None else out if out is not None else (lambda s: print(s, flush=True))
+        super().__init__(options, said, report)
         try:
             self.domain_id = domain_id_from_env() if options.domain_id is None else options.domain_id
         except ValueError as exc:

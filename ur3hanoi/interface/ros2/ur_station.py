@@ -99,7 +99,8 @@ class Ros2DriverStation(DriverStation):
                                            "remove": "ur3hanoi/remove_block", "hold": "ur3hanoi/hold_arm"}
 
     def __init__(self, options: Ros2DriverOptions, out: Callable[[str], None] | None = None,
-                 log: Callable[[str], None] | None = None) -> None:
+                 log: Callable[[str], None] | None = None,
+                 report_out: Callable[[str], None] | None = None) -> None:
         from ur3hanoi.interface.ros2.distros import ROS_DISTROS
 
         if options.distro not in ROS_DISTROS:
@@ -113,9 +114,11 @@ class Ros2DriverStation(DriverStation):
 
             options = replace(options, profile=profile_for(options.distro),
                               initial_controller=names_for(options.distro).follow_joint_trajectory.split("/")[1])
-        printed = out if out is not None else (lambda s: print(s, flush=True))
+        # stdout carries the JSON report alone (``station > report.json``); the ready line goes with the logs
+        said = out if out is not None else (lambda s: print(s, file=sys.stderr, flush=True))
         self._log_line = log if log is not None else (lambda s: print(s, file=sys.stderr, flush=True))
-        super().__init__(options, printed, printed)
+        report = report_out if report_out is not None else out if out is not None else (lambda s: print(s, flush=True))
+        super().__init__(options, said, report)
         self.names = names_for(options.distro)
         self._goals: dict[Hashable, _Goal] = {}
         self._lock = threading.Lock()
@@ -255,5 +258,5 @@ class Ros2DriverStation(DriverStation):
         return (f"{READY_LINE} on ROS_DOMAIN_ID {self.domain_id} ({opts.network}): the UR driver's interface "
                 f"({opts.distro}: {self.names.follow_joint_trajectory}), {st.name} ({st.robot.title}), {w.n_blocks} "
                 f"blocks on tower {opts.start + 1}, {1.0 / w.config.period_s:g} Hz, speed scaling "
-                f"{opts.speed_scaling:g}, suction on DO {st.wiring.output} (pid {os.getpid()})")
+                f"{opts.speed_scaling:g}, {st.wiring.describe()} (pid {os.getpid()})")
 

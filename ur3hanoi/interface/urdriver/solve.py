@@ -4,6 +4,10 @@
 :func:`run_driver_solve` executes a :class:`ur3hanoi.plan.Plan` through a
 :class:`~ur3hanoi.interface.urdriver.client.DriverTransport`:
 
+0. **Vacuum.** The calibration's vacuum generator output (``io.vacuum_generator_output``; ENME480's UR3e cells:
+   ``set_io`` pin 12) is switched on before anything moves, as the course's bridge does; every output the suction
+   uses (the cup's, then the generator's) is switched off at the end and on every other way out: a halt, an error,
+   Ctrl-C or SIGTERM (which ur3hanoi raises as an interrupt), after the running goal is canceled.
 1. **Start.** The arm's joint states (by name) are compared with where the plan starts: within
    ``start_tolerance_rad`` it starts; farther, it is first brought there by a slow goal (``approach_speed`` of the
    limits; the line says so), or the solve refuses with the distance (``far_start="refuse"``). Never a jump.
@@ -16,7 +20,10 @@
    off for the planned dwell (and until the switch clears, at most ``release_timeout_s``). While a block is carried
    (lift, carry, place) every ``io_states`` is checked; the first without the block cancels the running goal.
 4. **Halt** (a block missing at a grasp or dropped in a carry): cancel, suction off, the arm waits at rest, then a
-   slow goal home; :class:`~ur3hanoi.errors.SuctionFaultError` (exit 3), one line as the lab program's.
+   slow goal home; :class:`~ur3hanoi.errors.SuctionFaultError` (exit 3), one line as the lab program's. A grasp
+   whose vacuum sensor reads the calibration's no-vacuum level (nearer its ``ain0_off`` than its ``ain0_free``)
+   although the cup's output is on is a cell without vacuum, not a missing block: the line says so and names the
+   generator's pin (or that the calibration names none).
 5. **Errors.** A goal the controller rejects or aborts: suction off,
    :class:`~ur3hanoi.interface.urdriver.client.DriverGoalError` (exit 2) with the driver's code and error string; a
    goal past its timeout: canceled, suction off,
@@ -34,6 +41,7 @@
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
@@ -49,8 +57,9 @@ from ur3hanoi.interface.urdriver.facts import CONTROLLER_JOINTS, FUN_SET_DIGITAL
 from ur3hanoi.interface.urdriver.goal import TrajectoryGoal
 from ur3hanoi.interface.urdriver.path_deviation import PathDeviation, path_deviation, stretch_windows
 from ur3hanoi.interface.urdriver.plan_goals import Stretch, move_goal, plan_stretches
+from ur3hanoi.interface.urdriver.vacuum import feedback_text, no_vacuum, vacuum_hint
 from ur3hanoi.plan import Plan
-from ur3hanoi.station.suction_wiring import SuctionWiring
+from ur3hanoi.station.suction_wiring import GENERATOR_KEY, SuctionWiring, output_name
 
 
 @dataclass(frozen=True)
@@ -99,18 +108,13 @@ class _Solve:
         self.tr, self.plan, self.wiring, self.cfg, self.say = transport, plan, wiring, cfg, say
         self.goals = 0
         self.n_goals = 0
+        self.active: GoalHandle | None = None
+        self.last: dict[int, bool | None] = {}  # each output's last state set_io confirmed (None: asked, unanswered)
 
     # ------------------------------------------------------------------------------------------ reading
     def held(self) -> bool:
         io = self.tr.latest().io
         return io is not None and io.digital_in[self.wiring.switch_input]
-
-    def feedback_text(self) -> str:
-        io, w = self.tr.latest().io, self.wiring
-        if io is None:
-            return "no io_states"
-        return f"DI{w.switch_input}={int(io.digital_in[w.switch_input])}, AI{w.sensor_input}=" \
-               f"{io.analog_in[w.sensor_input][1]:.2f} V"
 
     def q(self) -> FloatArray:
         st = self.tr.latest()
@@ -135,7 +139,7 @@ class _Solve:
         cfg, tr = self.cfg, self.tr
         self.goals += 1
         label = f"goal {self.goals}" + (f"/{self.n_goals}" if self.goals <= self.n_goals else "") + f" ({what})"
-        handle = tr.send_goal(goal)
+        handle = self.active = tr.send_goal(goal)
         allowed = goal.points[-1].time_from_start_s + cfg.goal_margin_s if goal.points else cfg.goal_margin_s
         tau, last = 0.0, self.tr.now()
         while not handle.done():
@@ -159,6 +163,7 @@ class _Solve:
                 self.suction(False)
                 raise DriverError(f"{label} did not finish within {allowed:.1f} s of trajectory time (the speed "
                                   f"scaling the driver reports counted): canceled, suction off")
+        self.active = None
         result = handle.result()
         # The controller's end and the program's topic travel apart: a goal ended as a stop ends it waits for both.
         if result.status != "succeeded" and (result.status == "preempted" or result.code == ErrorCode.INVALID_GOAL) \
@@ -193,11 +198,34 @@ class _Solve:
             handle.cancel()
             self.sleep(1.0, handle.done)
 
+    def output(self, pin: int, on: bool, key: str) -> None:
+        """``set_io`` digital output ``pin`` (the calibration's ``io.<key>``) on or off."""
+        self.last[pin] = None
+        if self.tr.set_io(FUN_SET_DIGITAL_OUT, pin, 1.0 if on else 0.0):
+            self.last[pin] = on
+        else:
+            raise DriverError(f"set_io(fun={FUN_SET_DIGITAL_OUT}, pin={pin}, state={1 if on else 0}) answered "
+                              f"success = false on {self.tr.where}: is the pin right (calibration io.{key}) and the "
+                              "robot program running?")
+
     def suction(self, on: bool) -> None:
-        if not self.tr.set_io(FUN_SET_DIGITAL_OUT, self.wiring.output, 1.0 if on else 0.0):
-            raise DriverError(f"set_io(fun={FUN_SET_DIGITAL_OUT}, pin={self.wiring.output}, state="
-                              f"{1 if on else 0}) answered success = false on {self.tr.where}: is the pin right "
-                              "(calibration io.suction_output) and the robot program running?")
+        self.output(self.wiring.output, on, "suction_output")
+
+    def generator_on(self) -> None:
+        """The vacuum generator's output on, before anything moves (as ENME480's bridge does at its start)."""
+        pin = self.wiring.generator
+        if pin is not None:
+            self.output(pin, True, GENERATOR_KEY)
+            self.say(f"vacuum generator on: {output_name(pin)} (calibration io.{GENERATOR_KEY})")
+
+    def stop_active(self) -> bool:
+        """Cancel the running goal and wait for the arm to stop; False: none was running."""
+        handle, self.active = self.active, None
+        if handle is None or handle.done():
+            return False
+        self._cancel(handle)
+        self.at_rest()
+        return True
 
     def move_to(self, q1: FloatArray, speed: float, what: str) -> float:
         """A slow goal from where the arm is to ``q1``; returns its duration [s]."""
@@ -256,27 +284,63 @@ class _Solve:
 
     def halt(self, kind: str, move: int) -> SuctionFaultError:
         """Suction off, the arm at rest, then home; the error to raise."""
-        feedback = self.feedback_text()
+        if kind == "missing" and no_vacuum(self.tr.latest().io, self.wiring, self.plan.station.suction):
+            kind = "vacuum"
+        feedback = feedback_text(self.tr.latest().io, self.wiring, outputs=kind == "vacuum")
         self.suction(False)
         self.at_rest()
         self.move_to(self.plan.station.q_home_array, self.cfg.home_speed, "home after the halt")
         moves = self.plan.moves
         mv = moves[move]
-        where = (f"at tower {mv.from_tower + 1} height {mv.from_height + 1}" if kind == "missing"
+        where = (f"at tower {mv.from_tower + 1} height {mv.from_height + 1}" if kind != "dropped"
                  else f"while carrying it from tower {mv.from_tower + 1} to tower {mv.to_tower + 1}")
-        return SuctionFaultError(
-            f"suction fault in move {move + 1}/{len(moves)}: {block_colour(mv.block)} block {mv.block + 1} "
-            f"{'is missing' if kind == 'missing' else 'was dropped'} {where} ({feedback}); halted, suction off, "
-            "arm returned home")
+        block = f"{block_colour(mv.block)} block {mv.block + 1}"
+        what = {"missing": f"{block} is missing {where}", "dropped": f"{block} was dropped {where}",
+                "vacuum": f"no vacuum at the grasp of {block} {where}"}[kind]
+        hint = vacuum_hint(self.wiring) if kind == "vacuum" else ""
+        return SuctionFaultError(f"suction fault in move {move + 1}/{len(moves)}: {what} ({feedback}); halted, "
+                                 f"suction off, arm returned home{hint}")
+
+
+def _all_off(run: _Solve, failing: bool) -> None:
+    """The way out: cancel a running goal (and let the arm stop), then every suction output off, the cup's
+    first (all but those this solve has already seen switched off). While ``failing`` (an exception, an
+    interrupt, on its way out) nothing here may replace it: a step that fails, even by a second Ctrl-C, is said
+    and the next one still runs; otherwise a failure raises."""
+    failed: list[str] = []
+    done: list[str] = []
+    steps: list[tuple[str, str, Callable[[], object]]] = [
+        ("the running goal canceled", "the running goal", run.stop_active)]
+    for pin, key in ((run.wiring.output, "suction_output"), (run.wiring.generator, GENERATOR_KEY)):
+        if pin is not None and run.last.get(pin) is not False:
+            steps.append((f"{output_name(pin)} off", output_name(pin),
+                          functools.partial(run.output, pin, False, key)))
+    for said, what, step in steps:
+        try:
+            if step() is not False:
+                done.append(said)
+        except (Exception, KeyboardInterrupt) as exc:
+            if not failing:
+                raise
+            failed.append(f"{what} ({type(exc).__name__}{': ' if str(exc) else ''}{exc})")
+    if failing and done:
+        run.say(f"stopping: {', '.join(done)}")
+    elif not failing and run.wiring.generator is not None:
+        run.say(f"vacuum generator off: {output_name(run.wiring.generator)}")
+    if failed:
+        run.say(f"on the way out, could not switch off or stop: {'; '.join(failed)}: switch the outputs "
+                "off on the pendant (I/O tab)")
 
 
 def run_driver_solve(transport: DriverTransport, plan: Plan, wiring: SuctionWiring,
                      config: DriverSolveConfig | None = None,
                      log: Callable[[str], None] | None = None) -> DriverSolveResult:
     """Execute ``plan`` through ``transport`` (connected) with the lab's suction checks (see the module docstring).
+    Every suction output (``wiring.outputs``) is off when this returns or raises, on any path.
 
     Raises:
-        SuctionFaultError: a block was missing or dropped; the arm has halted (suction off, home).
+        SuctionFaultError: a block was missing or dropped, or the cup had no vacuum; the arm has halted (suction
+            off, home).
         DriverGoalError: the controller rejected or aborted a goal (suction off).
         ProgramStoppedError: the External Control program stopped mid-solve (suction off, the arm where it was).
         DriverError: the arm is far from the plan's start (``far_start="refuse"``), the program is not running, a
@@ -284,9 +348,22 @@ def run_driver_solve(transport: DriverTransport, plan: Plan, wiring: SuctionWiri
     """
     cfg = config if config is not None else DriverSolveConfig()
     run = _Solve(transport, plan, wiring, cfg, log if log is not None else (lambda _s: None))
+    try:
+        result = _execute(run)
+    except BaseException:
+        _all_off(run, failing=True)
+        raise
+    _all_off(run, failing=False)
+    return result
+
+
+def _execute(run: _Solve) -> DriverSolveResult:
+    """The generator on, the arm to the plan's start, the plan's stretches; the halt raised on a suction fault."""
+    transport, plan = run.tr, run.plan
     stretches = plan_stretches(plan)
     run.n_goals = sum(s.kind == "motion" for s in stretches)
     t0 = transport.now()
+    run.generator_on()
     approach = run.start()
     t_plan = transport.now()
     move = -1

@@ -6,8 +6,10 @@ log, report, rendering) whose arm is the simulated UR robot under the driver's s
 - the robot: :class:`ur3hanoi.sim.servo_world.ServoWorld` (joint limits, its own speed scaling times the slider
   ``speed_scaling``, the servo, suction, blocks);
 - the controller: :class:`~ur3hanoi.interface.urdriver.follower.TrajectoryFollower` with the options' profile;
-- the IO: :class:`~ur3hanoi.interface.urdriver.io.IoBoard`: the suction follows the digital output the calibration's
-  wiring names (:class:`ur3hanoi.station.suction_wiring.SuctionWiring`), and its feedback (today's suction model:
+- the IO: :class:`~ur3hanoi.interface.urdriver.io.IoBoard`: the cup pulls while the digital output the calibration's
+  wiring names is on and, on a cell with one, the vacuum generator's output too
+  (:class:`ur3hanoi.station.suction_wiring.SuctionWiring`; without the generator the cup is open to the air: no
+  vacuum, nothing picked, the sensor at its no-vacuum level), and its feedback (today's suction model:
   vacuum switch = ``DIGIN`` bit 0, vacuum sensor = ``AIN0``) reads on the wiring's digital and analog inputs.
 
 A binding calls, from any thread, :meth:`~DriverStation.on_goal`, :meth:`~DriverStation.on_cancel`,
@@ -223,7 +225,8 @@ class DriverStation(ServerCore["ServoWorld"]):
         w, period = self.world, self.world.config.period_s
         self.io.cycle()
         wiring = self.station.wiring
-        w.set_suction(self.io.digital_out(wiring.output))
+        vacuum = wiring.generator is None or self.io.digital_out(wiring.generator)  # the cell's generator, if any
+        w.set_suction(self.io.digital_out(wiring.output) and vacuum)
         s = w.speed_scaling
         d = self.follower.update(w.q, w.qd, period, s)
         assert d.qd is not None and d.qdd is not None
@@ -268,6 +271,7 @@ class DriverStation(ServerCore["ServoWorld"]):
     def _report_final(self) -> dict[str, Any]:
         return {"goal_active": self.follower.active is not None, "program_running": self.program_running,
                 "controllers": self._controller_states(),
+                "digital_outputs_on": [pin for pin, on in enumerate(self.io.states.digital_out) if on],
                 "speed_scaling": round(self.world.speed_scaling, 6)}
 
     def _controller_states(self) -> dict[str, str]:
