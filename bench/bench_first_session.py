@@ -42,9 +42,6 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-ACCEPT = ("--accept", "1,3", "--accept", "2,1", "--accept", "3,1")
-"""The student vouches for the first contact of each tower: today's layout prior refuses towers moved this far
-(issue 37); without it the calibration is refused at ``f``."""
 STEP_TIMEOUT_S = 900.0
 UR3HANOI = [sys.executable, "-m", "ur3hanoi.cli"]
 
@@ -110,7 +107,7 @@ class Session:
         drv = ["--via", via, "--driver", "ur"]
         self.run("check", [*UR3HANOI, "check-arm", *drv, "--calibration", "lab_real", "--suction"])
         times["check"] = self.steps[-1][1]
-        out = subprocess.run([sys.executable, "-m", "tests.support.student_cell", str(f), "12", *drv, *ACCEPT],
+        out = subprocess.run([sys.executable, "-m", "tests.support.student_cell", str(f), "12", *drv],
                              cwd=REPO, env=self.env, capture_output=True, text=True, timeout=STEP_TIMEOUT_S)
         if out.returncode != 0 or not out.stdout.strip():
             raise SystemExit(f"teach failed:\n{out.stdout}\n{out.stderr}")

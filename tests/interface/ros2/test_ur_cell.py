@@ -22,8 +22,6 @@ from ur3hanoi.station.calibration import load_station
 
 pytestmark = [pytest.mark.rclpy, pytest.mark.skipif(NETNS_PROBLEM is not None, reason=NETNS_PROBLEM or "")]
 
-ACCEPT = "--accept 1,3 --accept 2,1 --accept 3,1"  # today's layout prior refuses towers moved this far (issue 37)
-
 
 def test_check_record_and_a_terminal_session_on_the_ros2_driver(tmp_path: Path) -> None:
     env = build_env("jazzy")
@@ -43,7 +41,7 @@ def test_check_record_and_a_terminal_session_on_the_ros2_driver(tmp_path: Path) 
         f"{pre} $UR3HANOI teach --via ros2 --driver ur --base lab_real -o {tmp_path}/now.yaml --record-now 1,3 "
         f"> {tmp_path}/now.out 2>&1; echo $? > {tmp_path}/now.code",
         f"{pre} {sys.executable} -m tests.support.pendant play > {tmp_path}/play.out 2>&1 || exit 92",
-        f"{pre} {sys.executable} -m tests.support.student_cell {tmp_path} 3 --via ros2 --driver ur {ACCEPT} "
+        f"{pre} {sys.executable} -m tests.support.student_cell {tmp_path} 3 --via ros2 --driver ur "
         f"> {tmp_path}/session.json 2> {tmp_path}/session.err",
         f"{check} --calibration ur3e_sim > {tmp_path}/other.json 2> /dev/null; echo $? > {tmp_path}/other.code",
         "kill -INT $ST; wait $ST; echo \"station exit $?\" >&2"]) + "\n"

@@ -93,9 +93,8 @@ def test_the_suction_is_switched_and_read_back_generator_first() -> None:
     assert said.startswith(f"suction on: DO{st.station.wiring.output}=1") and "no block held" in said
     assert arm.suction(False).startswith(f"suction off: DO{st.station.wiring.output}=0")
     wired = dataclasses.replace(st.station, wiring=dataclasses.replace(st.station.wiring, output=5))
-    if hasattr(wired.wiring, "generator"):
-        wired = dataclasses.replace(wired, wiring=dataclasses.replace(wired.wiring, generator=12))
-        assert suction_outputs(wired) == (12, 5)
+    wired = dataclasses.replace(wired, wiring=dataclasses.replace(wired.wiring, generator=12))
+    assert suction_outputs(wired) == (12, 5)
     switch_suction(link, wired, True)
     assert all(link.latest().io.digital_out[p] for p in suction_outputs(wired))
     with pytest.raises(DriverError, match="success = false"):

@@ -104,8 +104,7 @@ def suction_text(link: DriverTransport, station: Station) -> str:
 def suction_outputs(station: Station) -> tuple[int, ...]:
     """The outputs the suction needs on, in the order they are switched on: the vacuum generator's first where the
     calibration names one (``io.vacuum_generator_output``), then the cup's; off in the reverse order."""
-    generator = getattr(station.wiring, "generator", None)  # the io section's generator pin, where it has one
-    return (station.wiring.output,) if generator is None else (int(generator), station.wiring.output)
+    return station.wiring.outputs
 
 
 def switch_suction(link: DriverTransport, station: Station, on: bool) -> str:
