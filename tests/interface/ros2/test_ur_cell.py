@@ -32,7 +32,7 @@ def test_check_record_and_a_terminal_session_on_the_ros2_driver(tmp_path: Path) 
                f"--report {tmp_path}/report.json")
     check = f"{pre} $UR3HANOI check-arm --via ros2 --driver ur --json --suction"
     script = "\n".join([
-        f"{station} > {tmp_path}/st.out 2> {tmp_path}/st.err &", "ST=$!", f"wait_ready {tmp_path}/st.out || exit 90",
+        f"{station} > {tmp_path}/st.out 2> {tmp_path}/st.err &", "ST=$!", f"wait_ready {tmp_path}/st.err || exit 90",
         f"{check} --calibration {tmp_path}/student.yaml > {tmp_path}/check.json 2> {tmp_path}/check.err; "
         f"echo $? > {tmp_path}/check.code",
         f"{pre} {sys.executable} -m tests.support.pendant stop > {tmp_path}/stop.out 2>&1 || exit 91",
