@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from tests.support import reaper
+from tests.support.xdist_groups import pytest_collection_modifyitems  # noqa: F401  (make test: one worker a module)
 from ur3hanoi.errors import SimulationError
 from ur3hanoi.io.resources import stations_dir
 from ur3hanoi.opengl import use_platform

@@ -45,12 +45,33 @@ wait_ready() {  # wait_ready FILE: until the station printed its ready line (on 
   for _ in $(seq 1 300); do grep -q "ros2-station: ready" "$1" && return 0; sleep 0.2; done
   echo "station not ready" >&2; cat "$1" >&2; return 1
 }
+written() {  # written REPORT: how many reports the station wrote (its reports_written; 0 before the first)
+  "$UR3HANOI_PY" -c 'import json, sys
+try: print(json.load(open(sys.argv[1]))["reports_written"])
+except (OSError, ValueError, KeyError): print(0)' "$1"
+}
+snapshot() {  # snapshot PID REPORT COPY: SIGUSR1, then COPY the report once the station rewrote it (10 s at most)
+  local n; n=$(written "$2"); kill -USR1 "$1"
+  for _ in $(seq 1 200); do [ "$(written "$2")" -gt "$n" ] && { cp "$2" "$3"; return 0; }; sleep 0.05; done
+  echo "no report within 10 s of SIGUSR1" >&2; return 1
+}
+report_until() {  # report_until PID REPORT COPY EXPR: snapshots until EXPR (Python, on the report r) holds (30 s)
+  for _ in $(seq 1 60); do
+    snapshot "$1" "$2" "$3" || return 1
+    "$UR3HANOI_PY" -c 'import json, sys; r = json.load(open(sys.argv[1])); sys.exit(not eval(sys.argv[2]))' "$3" "$4" \
+      && return 0
+    sleep 0.5
+  done
+  echo "the report never had $4" >&2; return 1
+}
 """
 
 
 def in_netns(script: str, timeout: float, cwd: Path) -> subprocess.CompletedProcess[str]:
-    """Run ``script`` (bash) in a new network namespace; ``$UR3HANOI`` is the CLI. Killed after ``timeout`` [s]."""
-    env = dict(os.environ, UR3HANOI=UR3HANOI, PYTHONUNBUFFERED="1", ROS_DOMAIN_ID="0")
+    """Run ``script`` (bash) in a new network namespace; ``$UR3HANOI`` is the CLI, ``$UR3HANOI_PY`` its Python; the
+    PRELUDE's functions wait for what they can observe (a ready line, a report written). Killed after ``timeout``
+    [s]."""
+    env = dict(os.environ, UR3HANOI=UR3HANOI, UR3HANOI_PY=sys.executable, PYTHONUNBUFFERED="1", ROS_DOMAIN_ID="0")
     proc = subprocess.Popen(["unshare", "-n", "bash", "-c", PRELUDE + script], cwd=cwd, env=env, text=True,
                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             start_new_session=True)

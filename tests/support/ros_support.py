@@ -9,6 +9,7 @@ missing, except under CI (CI installs them with tools/ensure-system-deps.sh, so 
 from __future__ import annotations
 
 import contextlib
+import itertools
 import json
 import os
 import shutil
@@ -36,8 +37,33 @@ START_TIMEOUT_S = 60.0
 STOP_TIMEOUT_S = 20.0
 
 
+PORT_FLOOR = 20000
+"""The lowest port :func:`free_port` gives; it gives ports below the kernel's ephemeral range."""
+_ports_given = itertools.count()
+
+
+def _ephemeral_low() -> int:
+    try:
+        return int(Path("/proc/sys/net/ipv4/ip_local_port_range").read_text().split()[0])
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
 def free_port() -> int:
-    with socket.socket() as s:
+    """A TCP port free on 127.0.0.1 now, for a test's master. A port from ``bind(0)`` lies in the ephemeral range,
+    where any process's next connection or server (another test's node, side by side under ``make test``) may take
+    it before the master binds it; a port below that range is only taken by someone asking for it by number. Each
+    process walks the ports from a start of its own (by pid), so that tests side by side ask for different ones."""
+    span = _ephemeral_low() - PORT_FLOOR
+    for _ in range(max(span, 0)):
+        port = PORT_FLOOR + (os.getpid() * 97 + next(_ports_given)) % span
+        with socket.socket() as s:
+            try:
+                s.bind(("127.0.0.1", port))
+            except OSError:  # in use, or still in TIME_WAIT
+                continue
+            return port
+    with socket.socket() as s:  # no room below the ephemeral range on this machine
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
 

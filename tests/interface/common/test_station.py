@@ -7,6 +7,7 @@ from __future__ import annotations
 import gc
 import json
 import re
+import time
 from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
@@ -43,6 +44,7 @@ def test_the_report_does_not_grow_with_the_number_of_commands(make: Callable[[li
     for n in (1600, 8000):
         logged: list[str] = []
         node, here = make(logged)
+        t0 = time.monotonic()
         for i in range(n):
             node.on_command(SimpleNamespace(destination=here, v=4.0, a=4.0, io_0=bool(i % 2)))
             if i % 8 == 7:
@@ -50,7 +52,9 @@ def test_the_report_does_not_grow_with_the_number_of_commands(make: Callable[[li
         report = node.report()
         sizes.append(len(json.dumps(report, indent=1)))
         counts.append(report["commands"])
-        assert len(logged) <= 3, logged[:5]  # a few cycles of wall time: the first line and at most a summary
+        # The refusals' log: the first line at once, then a summary a second of the wall time the commands took
+        # (well under a second on an idle machine, more on a loaded one).
+        assert len(logged) <= 2 + (time.monotonic() - t0), logged[:5]
     assert [c["executed"] + c["rejected"] + c["queued"] for c in counts] == [1600, 8000]
     assert counts[0]["executed"] > 150 and counts[1]["executed"] > 900 and counts[1]["rejected"] > 6000
     assert report["event_counts"]["suction_on"] + report["event_counts"]["suction_off"] > 100

@@ -168,12 +168,16 @@ def test_a_flood_of_valid_commands_keeps_the_rate_and_bounds_log_and_report(tmp_
                       json.dumps([near, home])], env, 60.0)
         assert result.returncode == 0, result.stderr
         flood = json.loads(result.stdout.splitlines()[-1])
-        lines_during = len(st.stderr) - lines_before
+        during = st.stderr[lines_before:]
         report = st.stop()
+    # A busy machine adds the loop's lag warnings, a source of their own limited the same way (a line a second).
+    lags = [line for line in during if "loop: " in line and "behind real time" in line]
+    lines_during = len(during) - len(lags)
     assert flood["sent"] >= 0.9 * 1000 * seconds
     assert flood["positions"] >= 0.5 * 125 * seconds
     assert flood["max_gap_s"] < 0.25, flood  # 2 periods is the target; this bounds a stall on any shared CPU
-    assert lines_during <= seconds + 3, "".join(st.stderr[lines_before:][:5])
+    assert lines_during <= seconds + 3, "".join(during[:5])
+    assert len(lags) <= report["wall_time_s"] + 1, lags
     c = report["commands"]
     # Every command the station received is counted (rospy may lose a few in transport at this rate).
     assert 0.98 * flood["sent"] <= c["executed"] + c["rejected"] + c["queued"] <= flood["sent"]

@@ -222,9 +222,9 @@ $UR3HANOI ros2-station --timing honest --report {report} > {tmp_path}/st.out 2> 
 ST=$!
 wait_ready {tmp_path}/st.err || exit 90
 {PUBLISHER} '{json.dumps(bad)}' || exit 91
-kill -USR1 $ST; sleep 0.5; cp {report} {tmp_path}/snap.json
+snapshot $ST {report} {tmp_path}/snap.json || exit 93
 {PUBLISHER} '{json.dumps(good)}' || exit 92
-sleep 1.5
+report_until $ST {report} {tmp_path}/last.json 'r["commands"]["executed"] == 1 and r["final"]["ready"]' || exit 94
 kill -TERM $ST; wait $ST; echo "station exit $?" >&2
 """
     result = in_netns(script, 120.0, REPO)
@@ -236,7 +236,8 @@ kill -TERM $ST; wait $ST; echo "station exit $?" >&2
     assert len(reasons) == 5 and all(x.startswith(p) for x, p in zip(reasons, HONEST_REFUSALS, strict=True)), reasons
     assert snap["executed"] == [] and snap["commands"]["rejected"] == 5
     assert max(abs(a - b) for a, b in zip(snap["final"]["q"], load_station("ur3e_sim").q_home, strict=True)) < 1e-6
-    assert r["commands"]["executed"] == 1 and r["reports_written"] == snap["reports_written"] + 1
+    last = json.loads((tmp_path / "last.json").read_text())  # the last SIGUSR1 report, once the move was over
+    assert r["commands"]["executed"] == 1 and r["reports_written"] == last["reports_written"] + 1
     assert max(abs(a - b - o) for a, b, o in zip(r["final"]["q"], near, COURSE_OFFSET, strict=True)) < 5e-4
     lines = _log_lines(err)
     assert lines[0] == f"[ERROR] ur3e/command dropped, the arm does not move: {reasons[0]}"
@@ -270,9 +271,14 @@ kill -INT $ST; wait $ST; echo "station exit $?" >&2
     assert flood["sent"] >= 0.9 * 1000 * seconds
     assert flood["positions"] >= 0.5 * 125 * seconds
     assert flood["max_gap_s"] < 0.25, flood  # 2 periods is the target; this bounds a stall on any shared CPU
-    lines = _log_lines(err)
-    assert 1 <= len(lines) <= seconds + 3, lines[:5]
     r = json.loads(report.read_text())
+    lines = _log_lines(err)
+    # The refusals: about one line a second. A busy machine adds the loop's lag warnings, a source of their own
+    # limited the same way (one line a second of the station's run).
+    refusals = [line for line in lines if "ur3e/command" in line]
+    lags = [line for line in lines if line.startswith("[WARN] loop: ")]
+    assert 1 <= len(refusals) <= seconds + 3, refusals[:5]
+    assert len(refusals) + len(lags) == len(lines) and len(lags) <= r["wall_time_s"] + 1, lines
     c = r["commands"]
     assert c["executed"] + c["rejected"] + c["queued"] == r["transport"]["received"] <= flood["sent"]
     assert r["transport"]["received"] >= 0.5 * flood["sent"]  # DDS keep-last 10 may drop some at this rate
@@ -308,7 +314,7 @@ ST=$!
 wait_ready {tmp_path}/st.err || exit 90
 {PUBLISHER} --int ur3hanoi/remove_block 0 1 || exit 91
 {solve} > {tmp_path}/halt.json; echo "halt exit $?" >&2
-kill -USR1 $ST; sleep 0.5; cp {report} {tmp_path}/snap.json
+snapshot $ST {report} {tmp_path}/snap.json || exit 93
 {PUBLISHER} --int ur3hanoi/spawn 7 1 || exit 92
 {solve} > {tmp_path}/solve.json; echo "solve exit $?" >&2
 kill -INT $ST; wait $ST; echo "station exit $?" >&2
@@ -367,16 +373,25 @@ def test_a_station_restarted_right_after_a_sigkill_is_alone_in_the_graph_within_
     assert got["exit"] == 0 and got["stop_s"] < 2.0, got
 
 
+RENDERING_STOP_S = 5.0
+"""[s] A stop that finishes the video works (the frame in progress, the encoder's flush): within 2 s on an idle
+machine, 2.84 s was seen with six wall-clock tests side by side on 2 cores at load 16. Every wait of the stop path
+that could hang ends after 10 s or more (ur3hanoi.interface.common.render.FrameProcess), so this margin still tells a
+stop that waited out a timeout from one that did not."""
+
+
 @pytest.mark.dds
 @requires_netns
 def test_a_rendering_station_stops_within_2_s_and_its_sigkill_leaves_the_old_video_and_no_process(
         tmp_path: Path) -> None:
-    """SIGINT: the video is finished and the rendering process stopped within 2 s. SIGKILL: the rendering process
-    (it used to finish and put the half video in place of the old one) discards it and is gone within 2 s."""
+    """SIGINT: the video is finished and the rendering process stopped within 2 s (:data:`RENDERING_STOP_S` on a
+    loaded machine). SIGKILL: the rendering process (it used to finish and put the half video in place of the old
+    one) discards it and is gone within 2 s."""
     result = in_netns(f"{PROBE} video {tmp_path}", 240.0, REPO)
     assert result.returncode == 0, result.stdout + result.stderr
     got = json.loads(result.stdout.strip().splitlines()[-1])
-    assert got["sigint_exit"] == 0 and got["sigint_s"] < 2.0 and got["sigint_written"], got
+    assert got["sigint_exit"] == 0 and got["sigint_s"] < RENDERING_STOP_S and got["sigint_written"], got
+    assert got["sigint_renderer_gone_s"] is not None and got["sigint_renderer_gone_s"] < RENDERING_STOP_S, got
     assert got["sigint_left"] == [], got
     assert got["renderers"] >= 1 and got["renderer_gone_s"] is not None and got["renderer_gone_s"] < 2.0, got
     assert got["kept"] and got["files"] == ["out.mp4"] and "Traceback" not in got["errors"], got
