@@ -21,7 +21,7 @@ from pathlib import Path
 BENCH = Path(__file__).resolve().parent
 REPO = BENCH.parent
 FIRST = ("bench_plan.py", "bench_suction_hold.py", "bench_executes.py", "bench_ik.py", "bench_sim.py", "bench_ros.py",
-         "bench_driver.py", "bench_startup.py", "bench_render.py")
+         "bench_driver.py", "bench_first_session.py", "bench_startup.py", "bench_render.py")
 
 
 def scripts(only: list[str]) -> list[str]:

@@ -24,7 +24,8 @@ from ur3hanoi.lifecycle import Terminated, sigterm_raises
 from ur3hanoi.version import __version__
 
 COMMAND_MODULES: dict[str, str] = {
-    "tables": "tables", "check-table": "check_table", "calibrate": "calibrate", "teach": "teach", "plan": "plan",
+    "tables": "tables", "check-table": "check_table", "calibrate": "calibrate", "teach": "teach",
+    "check-arm": "check_arm", "plan": "plan",
     "solve": "solve", "ros-station": "ros", "ros-solve": "ros", "ros-env": "ros", "ros2-station": "ros2",
     "ros2-solve": "ros2", "ros2-env": "ros2"}
 """Each command's module in :mod:`ur3hanoi.cli`, in the order ``--help`` lists them. A run imports only its own

@@ -27,6 +27,7 @@ from ur3hanoi.cli.options import (
     station_number,
 )
 from ur3hanoi.cli.ros2 import add_dds_options
+from ur3hanoi.cli.teach_ur import add_teach_driver_options
 
 if TYPE_CHECKING:
     from ur3hanoi.station.calibration import Station
@@ -78,6 +79,7 @@ def add(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--master", metavar="URI", help="with --via ros: ROS master URI (default: $ROS_MASTER_URI, else "
                                                    "http://localhost:11311)")
     add_dds_options(p)
+    add_teach_driver_options(p)
     p.set_defaults(func=run)
 
 
@@ -86,19 +88,31 @@ def _check_options(args: argparse.Namespace) -> None:
         raise UsageError("--key is only used with --table")
     if args.master is not None and args.via != "ros":
         raise UsageError("--master is only used with --via ros")
+    if args.driver == "ur" and args.via == "ros2" and args.convention != "course":
+        raise UsageError("--convention is only used with --driver course: the UR driver's joint_states are named")
+    if args.ros_distro is not None and (args.driver != "ur" or args.via != "ros2"):
+        raise UsageError("--ros-distro is only used with --via ros2 --driver ur")
 
 
 def _names(args: argparse.Namespace, where: str = "") -> DriverNames:
     from ur3hanoi.teach.driver import DriverNames
 
+    if args.driver == "ur":
+        from ur3hanoi.teach.ur_driver import ur_names
+
+        return ur_names(where, args.via)
     if args.via == "ros":
         return DriverNames(where, "ur3/position", "ur3/command", "ros-solve")
     return DriverNames(where, "ur3e/position", "ur3e/command", "ros2-solve")
 
 
-def _connect(args: argparse.Namespace) -> tuple[Any, DriverNames]:
+def _connect(args: argparse.Namespace, base: Station) -> tuple[Any, DriverNames]:
     """The connected arm of ``--via`` and how messages name it (DriverError: no driver within ``--wait``)."""
     print(f"ur3hanoi teach: looking for the driver (at most {args.wait:g} s) ...", flush=True)
+    if args.driver == "ur":
+        from ur3hanoi.cli.teach_ur import connect_ur
+
+        return connect_ur(args, base)
     if args.via == "ros":
         from ur3hanoi.interface.ros1.client import ArmConfig, RosArm
 
@@ -162,11 +176,16 @@ def _session(args: argparse.Namespace, base: Station, base_label: str, taught: T
     from ur3hanoi.errors import DriverError
     from ur3hanoi.teach.session import Teacher
 
-    arm, names = _connect(args)
-    teacher = None
+    arm, names = _connect(args, base)
+    teacher: Teacher | None = None
     try:
         accept = {(t - 1, h - 1) for t, h in args.accept or ()}
-        teacher = Teacher(base, base_label, taught, arm, names, args.start - 1, accept)
+        if args.driver == "ur":
+            from ur3hanoi.teach.ur_driver import UrTeacher
+
+            teacher = UrTeacher(base, base_label, taught, arm, names, args.start - 1, accept)
+        else:
+            teacher = Teacher(base, base_label, taught, arm, names, args.start - 1, accept)
         if args.record_now is not None:
             _record_now(teacher, args.record_now, args.wait)
             return exit_codes.OK, teacher.taught
@@ -215,6 +234,10 @@ def _interactive(teacher: Any, names: DriverNames) -> int:
     n = len(teacher.taught.points)
     cont = f"; continuing {shown(teacher.taught.path)}: {n} point(s) recorded" if n else ""
     print(f"connected to the driver on {names.where} ({kind}){cont}", flush=True)
+    if hasattr(teacher.driver, "program_running"):
+        from ur3hanoi.teach.ur_driver import program_line
+
+        print(program_line(teacher.driver), flush=True)
     try:
         with Keys() as keys:
             run_session(teacher, keys, Screen())
@@ -265,7 +288,8 @@ def _finish(args: argparse.Namespace, base: Station, base_label: str, taught: Ta
     key = args.key or "real_pos"
     if args.table is not None:
         print(write_key(str(station_out), key, args.table))
-    print(f"next, slowly (an eighth of the lab's speed; watch it, a hand on the stop button): "
+    slowly = ("the pendant's speed slider at 25 %" if args.driver == "ur" else "an eighth of the lab's speed")
+    print(f"next, slowly ({slowly}; watch it, a hand on the stop button): "
           f"{_next_command(args, station_out, key, base.n_towers)}")
 
 
@@ -275,14 +299,18 @@ def _next_command(args: argparse.Namespace, station_out: Path, key: str, n_tower
 
     start = args.start
     end = n_towers if start != n_towers else 1
-    cmd = ["ur3hanoi", _names(args).solve]
+    cmd = ["ur3hanoi", _names(args).solve] + (["--driver", "ur"] if args.driver == "ur" else [])
     if args.table is not None:
         cmd += ["--table", args.table, "--key", key]
-    cmd += ["--calibration", station_out.as_posix(), "--start", str(start), "--end", str(end), "--v",
-            f"{FIRST_SOLVE_SPEED:g}", "--a", f"{FIRST_SOLVE_SPEED:g}"]
+    cmd += ["--calibration", station_out.as_posix(), "--start", str(start), "--end", str(end)]
+    cmd += ["--v", f"{FIRST_SOLVE_SPEED:g}", "--a", f"{FIRST_SOLVE_SPEED:g}"] if args.driver == "course" else []
     if args.via == "ros" and args.master:
         cmd += ["--master", args.master]
-    if args.via == "ros2":
+    if args.via == "ros2" and args.driver == "ur":
+        cmd += [] if args.ros_distro is None else ["--ros-distro", args.ros_distro]
+        cmd += [] if args.network == "loopback" else ["--network", args.network]
+        cmd += [] if args.domain_id is None else ["--domain-id", str(args.domain_id)]
+    elif args.via == "ros2":
         cmd += [] if args.convention == "course" else ["--convention", args.convention]
         cmd += [] if args.network == "loopback" else ["--network", args.network]
         cmd += [] if args.domain_id is None else ["--domain-id", str(args.domain_id)]

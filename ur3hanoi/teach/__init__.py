@@ -16,6 +16,8 @@ Module map (one concept each):
 - :mod:`~ur3hanoi.teach.session`: the session's state and actions (record, undo, skip, jog...).
 - :mod:`~ur3hanoi.teach.terminal`: keys without Enter and a live status in a plain terminal.
 - :mod:`~ur3hanoi.teach.interactive`: the keys and the loop of the terminal session.
+- :mod:`~ur3hanoi.teach.ur_driver`: on the official UR driver (``--driver ur``): the program's state, jog goals
+  refused while it is stopped, the suction key.
 
 This package sits beside the transports (it imports none of them): the command line connects a driver client
 (:class:`ur3hanoi.interface.course.client.TopicArm`) and passes it in.

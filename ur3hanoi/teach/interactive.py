@@ -76,7 +76,7 @@ def _act(teacher: Teacher, ch: str) -> tuple[str, list[str]]:
         return "", teacher.turn(1 if ch == "r" else -1)
     if ch in _STEPS:
         return "", teacher.set_step(_STEPS[ch])
-    actions = {"u": teacher.undo, "s": teacher.skip, "g": teacher.go, "h": lambda: list(KEY_HELP)}
+    actions = {"u": teacher.undo, "s": teacher.skip, "g": teacher.go, "h": lambda: [*KEY_HELP, *teacher.extra_help]}
     if ch in actions:
         return "", actions[ch]()
     if ch == "a":
@@ -84,6 +84,9 @@ def _act(teacher: Teacher, ch: str) -> tuple[str, list[str]]:
     if ch == "f":
         problem = _finish_problem(teacher)
         return ("", [problem]) if problem else ("finish", [])
+    other = teacher.other_key(ch)
+    if other is not None:
+        return "", other
     if ch.isprintable() and not ch.isspace():
         return "", [f"key {ch!r} does nothing here (h shows the keys)"]
     return "", []
@@ -91,7 +94,7 @@ def _act(teacher: Teacher, ch: str) -> tuple[str, list[str]]:
 
 def run(teacher: Teacher, keys: Keys, screen: Screen) -> None:
     """Run the session until ``f`` finishes it (see the module docstring)."""
-    screen.say([*KEY_HELP, teacher.next_line()])
+    screen.say([*KEY_HELP, *teacher.extra_help, teacher.next_line()])
     picker: _Picker | None = None
     next_draw = 0.0
     try:

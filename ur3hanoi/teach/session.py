@@ -87,6 +87,7 @@ class Teacher:
         self.record_hint = "Enter records it"
         self.warned_real = False
         self.named: Advice | None = None
+        self.extra_help: tuple[str, ...] = ()  # a driver's own keys (teach.ur_driver)
         self._advise()
 
     # ------------------------------------------------------------------------------------------------- naming
@@ -251,6 +252,10 @@ class Teacher:
             return stop
         t, h = self.named.tower, self.named.height
         return self._send(self.jogger.go_above(self.q(), self.base, t, h), f"go above {self.named.label}")
+
+    def other_key(self, ch: str) -> list[str] | None:
+        """A driver's own key (teach.ur_driver): its lines, or None when ``ch`` is not one."""
+        return None
 
     @property
     def contacts(self) -> int:

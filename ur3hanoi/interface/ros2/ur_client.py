@@ -39,6 +39,30 @@ _STATUS = {4: "succeeded", 5: "canceled", 6: "aborted"}
 """``action_msgs/GoalStatus``: SUCCEEDED 4, CANCELED 5, ABORTED 6 (anything else ends as ``lost``)."""
 
 
+GOAL_RESPONSE_WAIT_S = 1.0
+"""[s] how long the executor thread waits for :meth:`RclpyDriverTransport.send_goal` to register a goal request whose
+answer already arrived (see :func:`_race_free`)."""
+
+
+def _race_free(action_client: Any) -> Any:
+    """``rclpy.action.ActionClient`` without the race of a goal sent from another thread than the executor's
+    (ros2/rclpy#1123, unfixed in Jazzy's rclpy): ``send_goal_async`` registers the request's sequence number only after
+    sending it, and a driver answering before that makes the executor drop the answer ("Ignoring unexpected goal
+    response"): the goal's future never completes and the solve times out. Here the executor thread waits for the
+    registration first (it follows within microseconds; at most :data:`GOAL_RESPONSE_WAIT_S`)."""
+
+    class RaceFreeActionClient(action_client):
+        async def execute(self, taken_data: Any) -> Any:
+            if "goal" in taken_data:
+                sequence = taken_data["goal"][0]
+                end = time.monotonic() + GOAL_RESPONSE_WAIT_S
+                while sequence not in self._goal_sequence_number_to_goal_id and time.monotonic() < end:
+                    time.sleep(0.0005)
+            return await super().execute(taken_data)
+
+    return RaceFreeActionClient
+
+
 class RclpyGoal:
     """A goal sent through :class:`RclpyDriverTransport` (a
     :class:`~ur3hanoi.interface.urdriver.client.GoalHandle`)."""
@@ -142,7 +166,7 @@ class RclpyDriverTransport:
         # Transient local as the driver publishes it: the state before this client connected arrives too.
         node.create_subscription(std_msgs.Bool, n.program_running, self._on_program,
                                  QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL))
-        self.client = ActionClient(node, action.FollowJointTrajectory, n.follow_joint_trajectory)
+        self.client = _race_free(ActionClient)(node, action.FollowJointTrajectory, n.follow_joint_trajectory)
         self.set_io_client = node.create_client(ur_srv.SetIO, n.set_io)
         self._set_io_type = ur_srv.SetIO
         # One thread: no callback here blocks, and the multi-threaded executor's hand-off to a pool cost the io_states

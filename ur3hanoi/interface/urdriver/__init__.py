@@ -17,6 +17,9 @@ Modules, one concept each (importing this package needs neither ROS nor MuJoCo):
 - :mod:`~ur3hanoi.interface.urdriver.joint_record`: the joint states a client received, in bounded memory.
 - :mod:`~ur3hanoi.interface.urdriver.path_deviation`: how closely the executed suction point followed the plan.
 - :mod:`~ur3hanoi.interface.urdriver.loopback`: client and station in one process on the CPU clock.
+- :mod:`~ur3hanoi.interface.urdriver.cell`: the driver before a solve: teach's driver (jog goals, the suction read
+  back), the joint states of the last seconds.
+- :mod:`~ur3hanoi.interface.urdriver.check`: the cell checked before its first move (``check-arm``).
 
-Bindings: :mod:`ur3hanoi.interface.ros1` (``ur_server``, ``ur_client``) and :mod:`ur3hanoi.interface.ros2`.
+Bindings: :mod:`ur3hanoi.interface.ros1` (``ur_server``, ``ur_client``, ``ur_cell``) and :mod:`ur3hanoi.interface.ros2`.
 """
