@@ -72,11 +72,12 @@ def test_installed_wheel_runs_the_main_job_from_an_empty_folder(wheel: Path, tmp
     env_dir = tmp_path / "venv"
     venv.create(env_dir, with_pip=True)
     py = env_dir / "bin" / "python"
+    # Without PYTHONPATH also for pip: a checkout on it (its egg-info) would pass for the installed package.
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
     _run([py, "-m", "pip", "install", "-q", "--disable-pip-version-check", "-c", REPO / "requirements.lock",
-          wheel], cwd=tmp_path, timeout=600)
+          wheel], cwd=tmp_path, timeout=600, env=env)
     work = tmp_path / "empty"
     work.mkdir()
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
     exe = env_dir / "bin" / "ur3hanoi"
 
     solved = _run([exe, "solve", "--start", "1", "--end", "3"], cwd=work, timeout=300, env=env)
