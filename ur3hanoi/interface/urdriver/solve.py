@@ -197,8 +197,7 @@ class _Solve:
     def _cancel(self, handle: GoalHandle) -> None:
         if not handle.done():
             handle.cancel()
-            # A goal still in flight (sent, not yet accepted) is canceled once the driver accepts it: leaving
-            # before then would let the arm run it with nobody to stop it (1 s was short on a loaded machine).
+            # a goal sent but not yet accepted is canceled on acceptance: leave sooner and the arm runs it
             self.sleep(self.cfg.cancel_wait_s, handle.done)
 
     def output(self, pin: int, on: bool, key: str) -> None:
