@@ -77,7 +77,7 @@ class DriverSolveConfig:
     rest_timeout_s: float = 3.0
     poll_s: float = 0.002
     program_wait_s: float = 0.5
-    cancel_wait_s: float = 5.0
+    cancel_wait_s: float = 5.0  # a goal sent, not yet accepted, is canceled on acceptance: wait for it
 
 
 @dataclass(frozen=True)
@@ -197,7 +197,6 @@ class _Solve:
     def _cancel(self, handle: GoalHandle) -> None:
         if not handle.done():
             handle.cancel()
-            # a goal sent but not yet accepted is canceled on acceptance: leave sooner and the arm runs it
             self.sleep(self.cfg.cancel_wait_s, handle.done)
 
     def output(self, pin: int, on: bool, key: str) -> None:
