@@ -23,7 +23,7 @@ venv: $(STAMP)
 solve: $(STAMP)
 	$(VENV)/bin/ur3hanoi solve --start 1 --end 3
 
-# Two phases, each printing its wall time on stderr. The tests on the CPU clock run on every core (pytest-xdist); the
+# Two phases, each printing its slowest 25 tests and its wall time. The tests on the CPU clock run on every core (pytest-xdist); the
 # ones on the wall clock (ROS 1, DDS, rclpy) and the wheel build run after them, WALL_WORKERS side by side: their
 # processes mostly wait on real time (control cycles, DDS discovery, pip), and each test owns its master port, network
 # namespace, files and processes (tests/support/ros_support.py, ros2_support.py, reaper.py). The tests of a module
@@ -35,8 +35,8 @@ timed = start=$$(date +%s); $(2); code=$$?; echo "make $@: $(1) phase took $$(($
 
 # A sweep's further cases (marked `full`) run under make test-all only; each test says what make test still covers.
 test: $(STAMP)
-	@$(call timed,CPU-clock,$(VENV)/bin/python -m pytest -q -n auto -m "not ($(REALTIME) or full)")
-	@$(call timed,wall-clock,$(VENV)/bin/python -m pytest -q -n $(WALL_WORKERS) --dist loadgroup -m "($(REALTIME)) and not full")
+	@$(call timed,CPU-clock,$(VENV)/bin/python -m pytest -q --durations=25 -n auto -m "not ($(REALTIME) or full)")
+	@$(call timed,wall-clock,$(VENV)/bin/python -m pytest -q --durations=25 -n $(WALL_WORKERS) --dist loadgroup -m "($(REALTIME)) and not full")
 
 test-all: $(STAMP)
 	@$(call timed,CPU-clock,$(VENV)/bin/python -m pytest -q -n auto -m "not ($(REALTIME))")

@@ -172,7 +172,12 @@ def test_a_master_whose_station_died_is_waited_out_not_attached_to(tmp_path, mon
         t0 = time.monotonic()
         core.start()
         assert core.started and time.monotonic() - t0 >= 1.0
-        assert master_pid(uri) not in (None, old) and not alive(old) and not alive(guard)
+        assert master_pid(uri) not in (None, old) and not alive(old)
+        # the guard ends just after its master (its last clean-up can outlast the new start on a loaded machine)
+        deadline = time.monotonic() + 5.0
+        while alive(guard) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not alive(guard)
     finally:
         if guard:
             with contextlib.suppress(ProcessLookupError):
